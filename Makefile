@@ -1,0 +1,112 @@
+# tensor-servo: one Makefile for set-up, build, tests, demo and benchmarks.
+#   make demo    the main job on the embedded default robot (PUMA 560)
+#   make test    the whole suite (C++ unit tests, pytest: model, tools, RTL cocotb benches)
+#   make setup   Debian packages (if missing), .venv with pinned versions, the C++ model and bindings
+#   make bench   benchmark tables (docs/benchmarks.md)
+#   make golden  regenerate tb/golden/ from the model
+SHELL := /bin/bash
+.DEFAULT_GOAL := help
+
+VENV    := .venv
+PY      := $(VENV)/bin/python
+PIP     := $(VENV)/bin/pip
+BUILD   := build
+JOBS    ?= $(shell nproc 2>/dev/null || echo 2)
+
+CXX      ?= g++
+CXXSTD   := -std=c++17
+CXXWARN  := -Wall -Wextra -Werror=return-type
+CXXOPT   := -O2
+INCLUDES := -Imodel/include -I/usr/include/eigen3
+DEPFLAGS  = -MMD -MP
+
+PKG      := model/python/tensor_servo
+STAMP_APT  := $(BUILD)/.apt.stamp
+STAMP_VENV := $(VENV)/.stamp
+
+.PHONY: help setup build test test-cpp test-py demo bench golden lint clean distclean
+
+help:
+	@sed -n '2,7p' Makefile | sed 's/^# //'
+
+# ---- set-up ------------------------------------------------------------------------------------
+$(STAMP_APT): scripts/setup_system.sh
+	@mkdir -p $(BUILD)
+	bash scripts/setup_system.sh
+	@touch $@
+
+$(STAMP_VENV): requirements.lock requirements-headers.txt pyproject.toml | $(STAMP_APT)
+	test -x $(PY) || python3 -m venv $(VENV)
+	$(PIP) install -q --disable-pip-version-check -r requirements.lock
+	$(PIP) install -q --disable-pip-version-check --no-deps -r requirements-headers.txt
+	$(PIP) install -q --disable-pip-version-check --no-deps --no-build-isolation -e .
+	@touch $@
+
+# Paths that only the venv knows (evaluated lazily, after set-up).
+PYEXT    = $(shell $(PY) -c "import sysconfig; print(sysconfig.get_config_var('EXT_SUFFIX'))")
+PYBIND   = $(shell $(PY) -m pybind11 --includes)
+AP_TYPES = $(shell $(PY) -c "import importlib.util as u, os; print(os.path.join(u.find_spec('hls4ml').submodule_search_locations[0], 'templates/vivado/ap_types'))")
+
+setup: $(STAMP_VENV) build
+
+# ---- build ---------------------------------------------------------------------------------------
+MODEL_HDRS := $(wildcard model/include/tensor_servo/*.hpp)
+TEST_SRCS  := $(wildcard model/tests/*.cpp)
+TEST_OBJS  := $(patsubst model/tests/%.cpp,$(BUILD)/model_tests/%.o,$(TEST_SRCS))
+BIND_SRCS  := $(wildcard model/bindings/*.cpp)
+BIND_OBJS  := $(patsubst model/bindings/%.cpp,$(BUILD)/bindings/%.o,$(BIND_SRCS))
+BIND_STAMP := $(BUILD)/.bindings.stamp
+
+build: $(BUILD)/model_tests/run_tests $(BIND_STAMP)
+
+# Xilinx's ap_types headers warn under -Wall; they are third-party (-isystem) and quietened here.
+AP_QUIET := -Wno-uninitialized -Wno-maybe-uninitialized
+
+$(BUILD)/model_tests/%.o: model/tests/%.cpp | $(STAMP_VENV)
+	@mkdir -p $(@D)
+	$(CXX) $(CXXSTD) $(CXXOPT) $(CXXWARN) $(AP_QUIET) $(DEPFLAGS) $(INCLUDES) -isystem $(AP_TYPES) -c $< -o $@
+
+$(BUILD)/model_tests/run_tests: $(TEST_OBJS)
+	$(CXX) $(CXXOPT) $^ -o $@
+
+$(BUILD)/bindings/%.o: model/bindings/%.cpp | $(STAMP_VENV)
+	@mkdir -p $(@D)
+	$(CXX) $(CXXSTD) $(CXXOPT) $(CXXWARN) $(DEPFLAGS) -fPIC -fvisibility=hidden $(INCLUDES) $(PYBIND) -c $< -o $@
+
+$(BIND_STAMP): $(BIND_OBJS)
+	rm -f $(PKG)/_model.*.so
+	$(CXX) -shared $^ -o $(PKG)/_model$(PYEXT)
+	@touch $@
+
+-include $(wildcard $(BUILD)/model_tests/*.d $(BUILD)/bindings/*.d)
+
+# ---- tests ---------------------------------------------------------------------------------------
+test: setup
+	$(BUILD)/model_tests/run_tests
+	$(PY) -m pytest -n $(JOBS) -q
+
+test-cpp: build
+	$(BUILD)/model_tests/run_tests
+
+test-py: build
+	$(PY) -m pytest -n $(JOBS) -q
+
+# ---- the main job --------------------------------------------------------------------------------
+demo: setup
+	$(PY) -m tensor_servo.demo
+
+bench: setup
+	$(PY) scripts/bench.py
+
+golden: setup
+	$(VENV)/bin/tservo golden -o tb/golden
+
+lint: setup
+	@echo "lint: nothing yet"
+
+clean:
+	rm -rf $(BUILD) $(PKG)/_model.*.so
+	find . -name __pycache__ -prune -exec rm -rf {} +
+
+distclean: clean
+	rm -rf $(VENV)

@@ -1,0 +1,321 @@
+"""Chain description: the data model, JSON load/save and validation (docs/chain-format.md).
+
+Semantics (as URDF): the pose of the tool in the root frame is
+
+    T(q) = base * prod_i (origin_i * M_i(q_i)) * tool
+
+where ``M_i`` rotates by ``scale_i * q_i`` about ``axis_i`` (revolute) or translates by
+``scale_i * q_i * axis_i`` (prismatic), ``axis_i`` being a unit vector in joint frame i.
+Poses are ``{"xyz": [x, y, z], "quat_wxyz": [w, x, y, z]}``.
+
+Loading validates every field and raises :class:`InputError` naming the field.  Quaternions and
+axes are normalised when their norm is within ``UNIT_TOL`` of one (quaternions) or non-zero (axes);
+quaternions further from unit norm are rejected.
+"""
+from __future__ import annotations
+
+import json
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .errors import InputError
+
+#: relative tolerance on a quaternion norm: normalised within it, rejected beyond
+UNIT_TOL = 1e-3
+JOINT_TYPES = ("revolute", "prismatic")
+
+
+@dataclass
+class Pose:
+    """A rigid transform: translation ``xyz`` (m) and unit quaternion ``quat_wxyz``."""
+
+    xyz: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    quat_wxyz: np.ndarray = field(default_factory=lambda: np.array([1.0, 0.0, 0.0, 0.0]))
+
+    def to_dict(self) -> dict:
+        return {"xyz": [float(v) for v in self.xyz], "quat_wxyz": [float(v) for v in self.quat_wxyz]}
+
+    def matrix(self) -> np.ndarray:
+        """4x4 homogeneous matrix."""
+        T = np.eye(4)
+        T[:3, :3] = quat_to_matrix(self.quat_wxyz)
+        T[:3, 3] = self.xyz
+        return T
+
+    @staticmethod
+    def from_matrix(T: np.ndarray) -> "Pose":
+        return Pose(np.array(T[:3, 3], dtype=float), matrix_to_quat(T[:3, :3]))
+
+
+@dataclass
+class Limits:
+    """Joint limits in joint units; ``lower``/``upper`` None = no position limit (continuous)."""
+
+    lower: float | None = None
+    upper: float | None = None
+    velocity: float | None = None
+
+    @property
+    def bounded(self) -> bool:
+        return self.lower is not None and self.upper is not None
+
+    def to_dict(self) -> dict:
+        return {"lower": self.lower, "upper": self.upper, "velocity": self.velocity}
+
+
+@dataclass
+class Joint:
+    name: str
+    type: str  # "revolute" | "prismatic"
+    origin: Pose
+    axis: np.ndarray
+    limits: Limits = field(default_factory=Limits)
+    scale: float = 1.0
+
+    @property
+    def prismatic(self) -> bool:
+        return self.type == "prismatic"
+
+    def to_dict(self) -> dict:
+        d = {
+            "name": self.name,
+            "type": self.type,
+            "origin": self.origin.to_dict(),
+            "axis": [float(v) for v in self.axis],
+            "limits": self.limits.to_dict(),
+        }
+        if self.scale != 1.0:
+            d["scale"] = float(self.scale)
+        return d
+
+
+@dataclass
+class Chain:
+    name: str
+    joints: list[Joint]
+    base: Pose = field(default_factory=Pose)
+    tool: Pose = field(default_factory=Pose)
+
+    @property
+    def n(self) -> int:
+        return len(self.joints)
+
+    @property
+    def lower(self) -> np.ndarray:
+        """Lower position limits (-inf where unlimited)."""
+        return np.array([-np.inf if j.limits.lower is None else j.limits.lower for j in self.joints])
+
+    @property
+    def upper(self) -> np.ndarray:
+        return np.array([np.inf if j.limits.upper is None else j.limits.upper for j in self.joints])
+
+    @property
+    def scales(self) -> np.ndarray:
+        return np.array([j.scale for j in self.joints])
+
+    def to_dict(self) -> dict:
+        return {
+            "name": self.name,
+            "units": {"length": "m", "angle": "rad"},
+            "base": self.base.to_dict(),
+            "tool": self.tool.to_dict(),
+            "joints": [j.to_dict() for j in self.joints],
+        }
+
+    def to_json(self) -> str:
+        return json.dumps(self.to_dict(), indent=2) + "\n"
+
+    def save(self, path: str | os.PathLike) -> None:
+        write_atomic(path, self.to_json().encode())
+
+    def random_q(self, rng: np.random.Generator, size: int | None = None, wrap: float = math.pi) -> np.ndarray:
+        """Uniform random joint values within the limits (unlimited joints: within +-wrap)."""
+        lo = np.where(np.isfinite(self.lower), self.lower, -wrap)
+        hi = np.where(np.isfinite(self.upper), self.upper, wrap)
+        shape = (self.n,) if size is None else (size, self.n)
+        return rng.uniform(lo, hi, size=shape)
+
+
+# ---- quaternion helpers (float) --------------------------------------------------------------
+
+def quat_to_matrix(q: np.ndarray) -> np.ndarray:
+    w, x, y, z = q
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ])
+
+
+def matrix_to_quat(R: np.ndarray) -> np.ndarray:
+    """Unit quaternion (w >= 0) of a rotation matrix (Shepperd's method)."""
+    R = np.asarray(R, dtype=float)
+    tr = np.trace(R)
+    if tr > 0:
+        s = 2.0 * math.sqrt(tr + 1.0)
+        q = [0.25 * s, (R[2, 1] - R[1, 2]) / s, (R[0, 2] - R[2, 0]) / s, (R[1, 0] - R[0, 1]) / s]
+    elif R[0, 0] > R[1, 1] and R[0, 0] > R[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + R[0, 0] - R[1, 1] - R[2, 2])
+        q = [(R[2, 1] - R[1, 2]) / s, 0.25 * s, (R[0, 1] + R[1, 0]) / s, (R[0, 2] + R[2, 0]) / s]
+    elif R[1, 1] > R[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + R[1, 1] - R[0, 0] - R[2, 2])
+        q = [(R[0, 2] - R[2, 0]) / s, (R[0, 1] + R[1, 0]) / s, 0.25 * s, (R[1, 2] + R[2, 1]) / s]
+    else:
+        s = 2.0 * math.sqrt(1.0 + R[2, 2] - R[0, 0] - R[1, 1])
+        q = [(R[1, 0] - R[0, 1]) / s, (R[0, 2] + R[2, 0]) / s, (R[1, 2] + R[2, 1]) / s, 0.25 * s]
+    q = np.array(q)
+    q /= np.linalg.norm(q)
+    return q if q[0] >= 0 else -q
+
+
+# ---- validation ----------------------------------------------------------------------------------
+
+def _get(d: Any, key: str, where: str, required: bool = True, default: Any = None) -> Any:
+    if not isinstance(d, dict):
+        raise InputError(where, "expected an object")
+    if key not in d:
+        if required:
+            raise InputError(f"{where}.{key}" if where else key, "missing")
+        return default
+    return d[key]
+
+
+def _finite_vector(v: Any, n: int, where: str) -> np.ndarray:
+    if not isinstance(v, (list, tuple)) or len(v) != n:
+        raise InputError(where, f"expected a list of {n} numbers")
+    out = []
+    for x in v:
+        if isinstance(x, bool) or not isinstance(x, (int, float)):
+            raise InputError(where, f"expected a list of {n} numbers")
+        if not math.isfinite(x):
+            raise InputError(where, "not finite")
+        out.append(float(x))
+    return np.array(out)
+
+
+def _number(x: Any, where: str, allow_none: bool = False) -> float | None:
+    if x is None and allow_none:
+        return None
+    if isinstance(x, bool) or not isinstance(x, (int, float)):
+        raise InputError(where, "expected a number")
+    if not math.isfinite(x):
+        raise InputError(where, "not finite")
+    return float(x)
+
+
+def unit_quat(v: Any, where: str) -> np.ndarray:
+    q = _finite_vector(v, 4, where)
+    nrm = float(np.linalg.norm(q))
+    if abs(nrm - 1.0) > UNIT_TOL:
+        raise InputError(where, f"quaternion norm {nrm:.6g} is not 1 (tolerance {UNIT_TOL:g})")
+    return q / nrm
+
+
+def unit_axis(v: Any, where: str) -> np.ndarray:
+    a = _finite_vector(v, 3, where)
+    nrm = float(np.linalg.norm(a))
+    if nrm < 1e-9:
+        raise InputError(where, "zero vector")
+    return a / nrm
+
+
+def pose_from_dict(d: Any, where: str) -> Pose:
+    xyz = _finite_vector(_get(d, "xyz", where), 3, f"{where}.xyz")
+    q = unit_quat(_get(d, "quat_wxyz", where), f"{where}.quat_wxyz")
+    return Pose(xyz, q)
+
+
+def joint_from_dict(d: Any, where: str) -> Joint:
+    name = _get(d, "name", where)
+    if not isinstance(name, str) or not name:
+        raise InputError(f"{where}.name", "expected a non-empty string")
+    jtype = _get(d, "type", where)
+    if jtype not in JOINT_TYPES:
+        raise InputError(f"{where}.type", f"must be one of {', '.join(JOINT_TYPES)} (got {jtype!r})")
+    origin = pose_from_dict(_get(d, "origin", where), f"{where}.origin")
+    axis = unit_axis(_get(d, "axis", where), f"{where}.axis")
+    ld = _get(d, "limits", where, required=False, default={}) or {}
+    if not isinstance(ld, dict):
+        raise InputError(f"{where}.limits", "expected an object")
+    lim = Limits(
+        _number(ld.get("lower"), f"{where}.limits.lower", allow_none=True),
+        _number(ld.get("upper"), f"{where}.limits.upper", allow_none=True),
+        _number(ld.get("velocity"), f"{where}.limits.velocity", allow_none=True),
+    )
+    if (lim.lower is None) != (lim.upper is None):
+        raise InputError(f"{where}.limits", "give both lower and upper, or neither (continuous joint)")
+    if lim.bounded and lim.lower > lim.upper:
+        raise InputError(f"{where}.limits", f"lower {lim.lower:g} > upper {lim.upper:g}")
+    if jtype == "prismatic" and not lim.bounded:
+        raise InputError(f"{where}.limits", "a prismatic joint needs lower and upper limits")
+    if lim.velocity is not None and lim.velocity <= 0:
+        raise InputError(f"{where}.limits.velocity", "must be positive")
+    scale = _number(_get(d, "scale", where, required=False, default=1.0), f"{where}.scale")
+    if scale == 0.0:
+        raise InputError(f"{where}.scale", "must be non-zero")
+    return Joint(name, jtype, origin, axis, lim, scale)
+
+
+def chain_from_dict(d: Any) -> Chain:
+    if not isinstance(d, dict):
+        raise InputError("chain", "expected a JSON object at the top level")
+    name = _get(d, "name", "")
+    if not isinstance(name, str) or not name:
+        raise InputError("name", "expected a non-empty string")
+    units = _get(d, "units", "", required=False, default={"length": "m", "angle": "rad"})
+    if not isinstance(units, dict):
+        raise InputError("units", "expected an object")
+    if units.get("length", "m") != "m":
+        raise InputError("units.length", f"only 'm' is supported (got {units.get('length')!r})")
+    if units.get("angle", "rad") != "rad":
+        raise InputError("units.angle", f"only 'rad' is supported (got {units.get('angle')!r}); use a joint 'scale'")
+    base = pose_from_dict(_get(d, "base", "", required=False, default={"xyz": [0, 0, 0], "quat_wxyz": [1, 0, 0, 0]}), "base")
+    tool = pose_from_dict(_get(d, "tool", "", required=False, default={"xyz": [0, 0, 0], "quat_wxyz": [1, 0, 0, 0]}), "tool")
+    jl = _get(d, "joints", "")
+    if not isinstance(jl, list) or not jl:
+        raise InputError("joints", "expected a non-empty list")
+    joints = [joint_from_dict(j, f"joints[{i}]") for i, j in enumerate(jl)]
+    names = [j.name for j in joints]
+    dup = sorted({x for x in names if names.count(x) > 1})
+    if dup:
+        raise InputError("joints", f"duplicate joint name {dup[0]!r}")
+    return Chain(name, joints, base, tool)
+
+
+def load(path: str | os.PathLike) -> Chain:
+    """Load and validate a chain JSON file, or an embedded example by name (see robots.names())."""
+    p = Path(path)
+    if not p.exists():
+        from . import robots
+
+        if str(path) in robots.names():
+            return robots.load(str(path))
+        raise InputError(str(path), "no such file")
+    try:
+        d = json.loads(p.read_text())
+    except UnicodeDecodeError:
+        raise InputError(str(path), "not a text file") from None
+    except json.JSONDecodeError as e:
+        raise InputError(str(path), f"malformed JSON at line {e.lineno} column {e.colno}: {e.msg}") from None
+    return chain_from_dict(d)
+
+
+def write_atomic(path: str | os.PathLike, data: bytes) -> None:
+    """Write a file atomically: a temporary file in the same folder, then rename."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=str(path.parent))
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
