@@ -153,6 +153,48 @@ inline Dst wrap(fx<W, I, L> x) {
   return Dst::from_raw(static_cast<int64_t>(r << sh) >> sh);
 }
 
+// cvt with a run-time power of two: Dst = x * 2^-k rounded (AP_RND) and saturated.  Used where the
+// algorithm normalises by a leading-one position found at run time (the solver's reciprocal).
+template <class Dst, int W, int I, uint32_t L>
+inline Dst cvt_shr(fx<W, I, L> x, int k, Status& st) {
+  const int s = (W - I) + k - Dst::F;  // right shift of the raw value
+  int64_t r;
+  if (s > 0) {
+    r = s >= 62 ? 0 : detail::round_raw(x.raw, s, 0);  // |x.raw| <= 2^61: beyond, |value| <= 1/2 LSB -> 0
+  } else {
+    const int l = -s;
+    const int64_t lim = int64_t(1) << 62;
+    if (l >= 62 || x.raw >= (lim >> l) || x.raw < -(lim >> l)) r = x.raw > 0 ? Dst::RAW_MAX + 1 : (x.raw < 0 ? Dst::RAW_MIN - 1 : 0);
+    else r = detail::shl(x.raw, l);
+  }
+  if (r > Dst::RAW_MAX) { st.raise(Dst::FLAG); return Dst::from_raw(Dst::RAW_MAX); }
+  if (r < Dst::RAW_MIN) { st.raise(Dst::FLAG); return Dst::from_raw(Dst::RAW_MIN); }
+  return Dst::from_raw(r);
+}
+template <class Dst>
+inline double cvt_shr(double x, int k, Status&) { return std::ldexp(x, -k); }
+
+// Position of the leading one of a positive value: returns k with 2^k <= x < 2^(k+1); x <= 0
+// returns INT_MIN/2 (callers treat it as "zero").
+template <int W, int I, uint32_t L>
+inline int ilog2(fx<W, I, L> x) {
+  if (x.raw <= 0) return -(1 << 20);
+  return (63 - __builtin_clzll(static_cast<unsigned long long>(x.raw))) - (W - I);
+}
+inline int ilog2(double x) {
+  if (!(x > 0)) return -(1 << 20);
+  int e;
+  std::frexp(x, &e);
+  return e - 1;
+}
+
+// Largest value of a storage format (+inf for double).
+template <class T>
+inline T max_of() {
+  if constexpr (std::is_same_v<T, double>) return HUGE_VAL;
+  else return T::from_raw(T::RAW_MAX);
+}
+
 // ---- double instantiation: the identity ---------------------------------------------------------
 template <class Dst>
 inline double cvt(double x, Status&) { return x; }

@@ -38,6 +38,26 @@ struct FmtDouble {
   static constexpr int TRIG_TABLE_BITS = 8;
   using twopi_t = double;
   using sixth_t = double;
+  // coordinate solver and servo law
+  using lchar_t = double;
+  using tw_t = double;
+  using jsc_t = double;
+  using qd_t = double;
+  using gk_t = double;
+  using mant_t = double;
+  using recip_t = double;
+  using mu_t = double;
+  using step_t = double;
+  using klim_t = double;
+  using gain_t = double;
+  using dt_t = double;
+  using vel_t = double;
+  using perr_t = double;
+  using rot_t = double;
+  using rvf_t = double;
+  using tacc_t = double;
+  static constexpr int RECIP_TABLE_BITS = 6;
+  static constexpr int ROTVEC_TABLE_BITS = 6;
 };
 
 // Default: accuracy goal (FK <= 5 um / 10 urad, Jacobian entries within 1e-5) with margin.
@@ -67,6 +87,26 @@ struct FmtDefault {
   static constexpr int TRIG_TABLE_BITS = 8;    // 256 (sin, cos) pairs over a quarter turn
   using twopi_t = fx<27, 4>;                   // 2*pi; error 6e-8 -> < 6e-11 rad on d
   using sixth_t = fx<18, 0>;                   // 1/6 in sin d = d - d (d^2/6)
+  // coordinate solver (solver.hpp) and servo law (servo.hpp)
+  using lchar_t = fx<18, 3, ST_OVF_CONST>;     // characteristic length L (m/rad), 0 < L < 4
+  using tw_t = fx<27, 6, ST_OVF_SOLVER>;       // scaled target / residual (L omega; v), |.| < 32 m/s
+  using jsc_t = fx<27, 5, ST_OVF_SOLVER>;      // scaled Jacobian column (L omega_i; v_i), |.| < 16
+  using qd_t = fx<27, 6, ST_OVF_SOLVER>;       // joint rates q', |.| < 32 joint units/s
+  using gk_t = fx<27, 7, ST_OVF_SOLVER>;       // <J_i, r> 2^-k_i (normalised projection)
+  using mant_t = fx<18, 2>;                    // d_i 2^-k_i in [1, 2) (truncated)
+  using recip_t = fx<18, 2, ST_OVF_SOLVER>;    // 1 / mant in (1/2, 1]
+  using mu_t = fx<18, 2, ST_OVF_CONST>;        // per-joint multiplier (relaxation), [0, 2)
+  using step_t = fx<18, 2, ST_OVF_SOLVER>;     // mu_i / mant_i
+  using klim_t = fx<27, 15, ST_OVF_CONST>;     // limit-approach gain (1/s)
+  using gain_t = fx<27, 15, ST_OVF_CONST>;     // servo gains K_p, K_o (1/s)
+  using dt_t = fx<32, -3, ST_OVF_CONST>;       // tick period (s), < 1/8 s
+  using vel_t = fx<27, 6, ST_OVF_SERVO>;       // setpoint twist U' and command V (omega; v), |.| < 32
+  using perr_t = fx<27, 4, ST_OVF_SERVO>;      // position error (m), |.| < 8
+  using rot_t = fx<27, 3, ST_OVF_SERVO>;       // orientation error, rotation vector (rad), |.| <= pi
+  using rvf_t = fx<27, 2, ST_OVF_SERVO>;       // phi / sin(phi) table for the rotation vector, [1, pi/2]
+  using tacc_t = fx<60, 17, ST_OVF_SOLVER>;    // exact accumulator of Vs - sum Js_i q'_i (n <= 64)
+  static constexpr int RECIP_TABLE_BITS = 6;
+  static constexpr int ROTVEC_TABLE_BITS = 6;
 };
 
 // Compact: every multiplier operand <= 18 bits (one DSP per product on ECP5 and 7-series).
@@ -94,6 +134,25 @@ struct FmtCompact {
   static constexpr int TRIG_TABLE_BITS = 8;
   using twopi_t = fx<18, 4>;                   // error 3e-5 -> < 3e-8 rad on d
   using sixth_t = fx<18, 0>;
+  using lchar_t = fx<18, 3, ST_OVF_CONST>;
+  using tw_t = fx<18, 6, ST_OVF_SOLVER>;
+  using jsc_t = fx<18, 5, ST_OVF_SOLVER>;
+  using qd_t = fx<18, 6, ST_OVF_SOLVER>;
+  using gk_t = fx<18, 7, ST_OVF_SOLVER>;
+  using mant_t = fx<18, 2>;
+  using recip_t = fx<18, 2, ST_OVF_SOLVER>;
+  using mu_t = fx<18, 2, ST_OVF_CONST>;
+  using step_t = fx<18, 2, ST_OVF_SOLVER>;
+  using klim_t = fx<18, 15, ST_OVF_CONST>;
+  using gain_t = fx<18, 15, ST_OVF_CONST>;
+  using dt_t = fx<18, -3, ST_OVF_CONST>;
+  using vel_t = fx<18, 6, ST_OVF_SERVO>;
+  using perr_t = fx<18, 4, ST_OVF_SERVO>;
+  using rot_t = fx<18, 3, ST_OVF_SERVO>;
+  using rvf_t = fx<18, 2, ST_OVF_SERVO>;
+  using tacc_t = fx<42, 17, ST_OVF_SOLVER>;
+  static constexpr int RECIP_TABLE_BITS = 6;
+  static constexpr int ROTVEC_TABLE_BITS = 6;
 };
 
 

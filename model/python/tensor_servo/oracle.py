@@ -56,5 +56,5 @@ class PinChain:
         qq = np.asarray(q, float) * self.scales
         pin.computeJointJacobians(self.model, self.data, qq)
         pin.framesForwardKinematics(self.model, self.data, qq)
-        J = pin.getFrameJacobian(self.model, self.data, self.tool_id, rf)
+        J = np.reshape(pin.getFrameJacobian(self.model, self.data, self.tool_id, rf), (6, -1))
         return np.vstack([J[3:], J[:3]]) * self.scales[None, :]

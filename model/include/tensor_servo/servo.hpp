@@ -1,0 +1,184 @@
+// tensor-servo: the tracking servo law around the coordinate solver (one servo tick).
+//
+// Inputs per tick: measured joint values q, the setpoint pose U = (Q_U, p_U) and twist
+// U' = (omega_U; v_U) of the controlled frame, gains.  Output: joint-rate commands q' (and, in
+// virtual mode, the integrated model q + q' dt clamped to the limits).
+//
+// Error choice A (default; digest a.5 [FIX] 2A): root (or setpoint-frame) basis, geometric Jacobian
+// at the controlled frame's origin:
+//     e_p = p_U - p_P,   e_o = rotvec(Q_U (x) conj(Q_P)),   V = [omega_U + K_o e_o ; v_U + K_p e_p]
+// Error choice B (digest a.5 [FIX] 2B): body basis of the controlled frame, body Jacobian:
+//     E_b = P^-1 U:  e_o = rotvec(conj(Q_P) (x) Q_U),  e_p = R_P^T (p_U - p_P)
+//     V = [R_P^T omega_U + K_o e_o ; R_P^T (v_U + omega_U x (p_P - p_U)) + K_p e_p]
+//     (the feed-forward twist carried from U's origin to P's and into P's axes: Ad_{E_b} V_U^b)
+// Error-only mode (the seed's alternative): U' is not fed forward.
+// Moving local basis (seed section 11): the setpoint may be given relative to frame k of the chain.
+// Then P is replaced by T_k^-1 P, the Jacobian is taken in frame k's axes and its columns 1..k are
+// zero (joints up to k move frame k and the controlled frame together).
+//
+// Rotation vector without a divider: for a unit quaternion (w, u) with w >= 0 (sign flipped
+// otherwise), rotvec = 2 f(w) u with f(w) = acos(w) / sqrt(1 - w^2) = (phi/2) / sin(phi/2), taken
+// from a table of 2^T + 1 values on w = j 2^-T with linear interpolation (T = ROTVEC_TABLE_BITS).
+#pragma once
+#include "solver.hpp"
+
+namespace ts {
+
+enum ErrorMode : int { ERR_A = 0, ERR_B = 1 };
+
+template <class Fmt>
+struct RotvecTable {
+  static constexpr int N = 1 << Fmt::ROTVEC_TABLE_BITS;
+  typename Fmt::rvf_t f[N + 1];
+  typename Fmt::rvf_t df[N + 1];
+  static double fexact(double w) { return w >= 1.0 ? 1.0 : std::acos(w) / std::sqrt(1.0 - w * w); }
+  RotvecTable() {
+    Status st;
+    for (int j = 0; j <= N; ++j) f[j] = from_double<typename Fmt::rvf_t>(fexact(double(j) / N), st);
+    for (int j = 0; j <= N; ++j)
+      df[j] = j < N ? cvt<typename Fmt::rvf_t>(f[j + 1] - f[j], st) : typename Fmt::rvf_t{};
+  }
+  static const RotvecTable& get() {
+    static const RotvecTable t;
+    return t;
+  }
+};
+
+// Rotation vector (rad) of a unit quaternion, in rot_t.
+template <class Fmt>
+inline Vec3<typename Fmt::rot_t> rotvec(Quat<typename Fmt::quat_t> q, Status& st) {
+  using quat_t = typename Fmt::quat_t;
+  using rot_t = typename Fmt::rot_t;
+  if (q.c[0] < quat_t{}) q = Quat<quat_t>{{cvt<quat_t>(-q.c[0], st), cvt<quat_t>(-q.c[1], st), cvt<quat_t>(-q.c[2], st), cvt<quat_t>(-q.c[3], st)}};
+  Vec3<rot_t> r;
+  if constexpr (Fmt::is_float) {
+    const double f = RotvecTable<Fmt>::fexact(q.c[0]);
+    for (int a = 0; a < 3; ++a) r.c[a] = 2.0 * f * q.c[a + 1];
+  } else {
+    using rvf_t = typename Fmt::rvf_t;
+    constexpr int T = Fmt::ROTVEC_TABLE_BITS;
+    constexpr int FB = quat_t::F - T;  // fraction bits of the interpolation weight
+    const int64_t w = q.c[0].raw;
+    int idx = static_cast<int>(w >> FB);
+    int64_t frac = w & ((int64_t(1) << FB) - 1);
+    if (idx > (1 << T)) { idx = 1 << T; frac = 0; }  // w > 1 + 2^-T cannot come from a unit quaternion
+    const auto& tab = RotvecTable<Fmt>::get();
+    const auto wgt = fx<FB + 1, 1>::from_raw(frac);
+    const rvf_t f = cvt<rvf_t>(tab.f[idx] + tab.df[idx] * wgt, st);
+    for (int a = 0; a < 3; ++a) r.c[a] = cvt<rot_t>(pow2<1>(f * q.c[a + 1]), st);
+  }
+  return r;
+}
+
+template <class Fmt, int NMAX>
+struct ServoParams {
+  SolverParams<Fmt, NMAX> solver;
+  typename Fmt::gain_t kp, ko;      // position and orientation gains (1/s)
+  typename Fmt::dt_t dt;            // tick period (s), used in virtual mode
+  int mode = ERR_A;
+  bool feedforward = true;          // false: the seed's error-only mode
+  int controlled = -1;              // frame whose pose is servoed (-1: tool)
+  int setpoint_frame = -1;          // -1: U in the root frame; k: U relative to frame k
+};
+
+template <class Fmt>
+struct Setpoint {
+  Quat<typename Fmt::quat_t> Q;
+  Vec3<typename Fmt::pos_t> p;
+  Vec3<typename Fmt::vel_t> w, v;   // twist (omega; v): v of the controlled point, axes as for e
+};
+
+template <class Fmt, int NMAX>
+struct TickResult {
+  typename Fmt::qd_t qd[NMAX];      // joint-rate command
+  typename Fmt::angle_t q_next[NMAX];  // q + q' dt, clamped to the limits (virtual mode)
+  Vec3<typename Fmt::perr_t> ep;    // position error
+  Vec3<typename Fmt::rot_t> eo;     // orientation error (rotation vector)
+  typename Fmt::tw_t r[6];          // final scaled residual of the solver
+  Frames<Fmt, NMAX> frames;
+  Jacobian<Fmt, NMAX> J;
+};
+
+// One servo tick.  qd_warm: the previous tick's q' (warm start).
+template <class Fmt, int NMAX>
+inline void servo_tick(const ChainQ<Fmt, NMAX>& ch, const ServoParams<Fmt, NMAX>& P,
+                       const typename Fmt::angle_t* q, const Setpoint<Fmt>& U, const typename Fmt::qd_t* qd_warm,
+                       TickResult<Fmt, NMAX>& R, Status& st) {
+  using quat_t = typename Fmt::quat_t;
+  using pos_t = typename Fmt::pos_t;
+  using perr_t = typename Fmt::perr_t;
+  using vel_t = typename Fmt::vel_t;
+  using tw_t = typename Fmt::tw_t;
+  const int n = ch.n;
+  const int ctl = P.controlled < 0 ? n + 1 : P.controlled;
+  const int k = P.setpoint_frame;
+  forward_kinematics(ch, q, R.frames, st);
+  const Frames<Fmt, NMAX>& f = R.frames;
+
+  // Pose of the controlled frame, relative to the setpoint frame when one is given.
+  Quat<quat_t> QP = f.Q[ctl];
+  Vec3<pos_t> pP = f.p[ctl];
+  if (k >= 0) {
+    QP = qmul<quat_t>(conj(f.Q[k], st), f.Q[ctl], st);
+    const Vec3<typename Fmt::lever_t> d = vsub<typename Fmt::lever_t>(f.p[ctl], f.p[k], st);
+    pP = rotate<pos_t, typename Fmt::len_tmp_t, true>(f.Q[k], d, st);
+  }
+  const Vec3<perr_t> dp = vsub<perr_t>(U.p, pP, st);  // p_U - p_P, setpoint axes
+  Vec3<vel_t> V_w, V_v;
+  int basis;
+  if (P.mode == ERR_A) {
+    basis = k;  // root (-1) or frame k
+    R.ep = dp;
+    R.eo = rotvec<Fmt>(qmul<quat_t>(U.Q, conj(QP, st), st), st);
+    for (int a = 0; a < 3; ++a) {
+      const auto fw = P.ko * R.eo.c[a];
+      const auto fv = P.kp * R.ep.c[a];
+      V_w.c[a] = P.feedforward ? cvt<vel_t>(U.w.c[a] + fw, st) : cvt<vel_t>(fw, st);
+      V_v.c[a] = P.feedforward ? cvt<vel_t>(U.v.c[a] + fv, st) : cvt<vel_t>(fv, st);
+    }
+  } else {
+    basis = ctl;
+    R.ep = rotate<perr_t, typename Fmt::len_tmp_t, true>(QP, dp, st);
+    R.eo = rotvec<Fmt>(qmul<quat_t>(conj(QP, st), U.Q, st), st);
+    Vec3<vel_t> ffw{}, ffv{};
+    if (P.feedforward) {
+      // omega_U x (p_P - p_U) = dp x omega_U
+      const Vec3<vel_t> lev = cross<vel_t>(dp, U.w, st);
+      const Vec3<vel_t> vP = vadd<vel_t>(U.v, lev, st);
+      ffw = rotate<vel_t, typename Fmt::jv_tmp_t, true>(QP, U.w, st);
+      ffv = rotate<vel_t, typename Fmt::jv_tmp_t, true>(QP, vP, st);
+    }
+    for (int a = 0; a < 3; ++a) {
+      V_w.c[a] = cvt<vel_t>(ffw.c[a] + P.ko * R.eo.c[a], st);
+      V_v.c[a] = cvt<vel_t>(ffv.c[a] + P.kp * R.ep.c[a], st);
+    }
+  }
+  // Jacobian of the controlled frame's origin; in frame k (moving local basis) or the body basis
+  // when a frame is given, the root otherwise.  With a setpoint frame, joints 1..k do not move P
+  // relative to frame k: their columns are zero.
+  jacobian(ch, f, ctl, basis < 0 ? -1 : (P.mode == ERR_A ? k : ctl), R.J, st);
+  if (k >= 1)
+    for (int i = 0; i < k && i < n; ++i)
+      for (int a = 0; a < 3; ++a) { R.J.w[i].c[a] = typename Fmt::jw_t{}; R.J.v[i].c[a] = typename Fmt::jv_t{}; }
+
+  // Scaled target and the solve.
+  tw_t vs[6];
+  for (int a = 0; a < 3; ++a) {
+    vs[a] = cvt<tw_t>(P.solver.L * V_w.c[a], st);
+    vs[a + 3] = cvt<tw_t>(V_v.c[a], st);
+  }
+  SolverColumns<Fmt, NMAX> C;
+  solver_prepare(P.solver, R.J, q, C, st);
+  for (int i = 0; i < n; ++i) R.qd[i] = qd_warm[i];
+  solver_run(P.solver, C, n, vs, R.qd, R.r, st);
+
+  // Virtual-mode integration, clamped to the position limits.
+  using angle_t = typename Fmt::angle_t;
+  for (int i = 0; i < n; ++i) {
+    angle_t qn = cvt<angle_t>(q[i] + R.qd[i] * P.dt, st);
+    if (P.solver.limited[i]) qn = tmax(P.solver.lo[i], tmin(qn, P.solver.hi[i]));
+    R.q_next[i] = qn;
+  }
+}
+
+}  // namespace ts
