@@ -114,7 +114,7 @@ struct FmtCompact {
   static constexpr bool is_float = false;
   static constexpr const char* name = "compact";
   using angle_t = fx<18, 4, ST_OVF_ANGLE>;
-  using kturn_t = fx<18, -1, ST_OVF_CONST>;
+  using kturn_t = fx<18, -2, ST_OVF_CONST>;     // |s| < pi/2
   using turn_t = fx<26, 0>;
   using scale_t = fx<18, 3, ST_OVF_CONST>;
   using tab_t = fx<18, 2, ST_OVF_TRIG>;

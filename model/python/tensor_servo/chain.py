@@ -319,3 +319,65 @@ def write_atomic(path: str | os.PathLike, data: bytes) -> None:
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
+
+
+# ---- helpers for tools that write chains (importers, examples) ------------------------------------
+
+def reach(chain: Chain) -> float:
+    """Bound on the distance between two frame origins of the chain, from the first joint frame on:
+    sum of |origin xyz|, |tool xyz| and prismatic strokes (|scale| * max(|lower|, |upper|)).
+    The same bound as the C++ model's ``chain_reach`` (it is checked against the lever-arm format)."""
+    r = float(np.linalg.norm(chain.tool.xyz))
+    for j in chain.joints:
+        r += float(np.linalg.norm(j.origin.xyz))
+        if j.prismatic and j.limits.bounded:
+            r += abs(j.scale) * max(abs(j.limits.lower), abs(j.limits.upper))
+    return r
+
+
+def _is_stable_unit(v: np.ndarray) -> bool:
+    return bool(np.array_equal(v / float(np.linalg.norm(v)), v))
+
+
+def _stable_unit(v: np.ndarray) -> np.ndarray:
+    """``v / |v|``, moved by a few ulps if needed so that normalising it again returns it unchanged.
+
+    The loader normalises every quaternion and axis; for about 2 % of unit vectors that is not
+    exactly idempotent in floating point, so a saved chain would not read back bit-identical."""
+    u = np.asarray(v, dtype=float)
+    for _ in range(4):
+        if _is_stable_unit(u):
+            return u
+        u = u / float(np.linalg.norm(u))
+    for k in range(1, 8):
+        for i in np.argsort(-np.abs(u)):
+            for direction in (np.inf, -np.inf):
+                w = u.copy()
+                for _ in range(k):
+                    w[i] = np.nextafter(w[i], direction)
+                if _is_stable_unit(w):
+                    return w
+    return u  # not reached in practice; the round trip is then off by one ulp
+
+
+def canonical(chain: Chain, eps: float = 1e-15) -> Chain:
+    """The chain as it will read back from its own JSON, validated.
+
+    Components of xyz, quaternions and axes with magnitude below ``eps`` are set to 0 (they are
+    rounding residue of importers, e.g. cos(pi/2)); quaternions and axes are normalised so that
+    ``chain_from_dict(json.loads(c.to_json()))`` reproduces ``c`` exactly.  Raises InputError if the
+    chain is not valid (the message names the field as in the JSON file)."""
+    def clean(v: np.ndarray) -> np.ndarray:
+        v = np.array(v, dtype=float)
+        v[np.abs(v) < eps] = 0.0
+        return v
+
+    def pose(p: Pose) -> Pose:
+        q = clean(p.quat_wxyz)
+        return Pose(clean(p.xyz), _stable_unit(q) if np.any(q) else q)
+
+    joints = [Joint(j.name, j.type, pose(j.origin), _stable_unit(a) if np.any(a := clean(j.axis)) else a,
+                    Limits(j.limits.lower, j.limits.upper, j.limits.velocity), j.scale)
+              for j in chain.joints]
+    c = Chain(chain.name, joints, pose(chain.base), pose(chain.tool))
+    return chain_from_dict(json.loads(c.to_json()))

@@ -13,7 +13,7 @@ import sys
 
 from .errors import InputError
 
-# Modules that add commands; a module that fails to import is reported, not fatal to the others.
+# Modules that add commands (each has register(subparsers)).
 COMMAND_MODULES = ["cli_chain", "cli_kin"]
 
 
