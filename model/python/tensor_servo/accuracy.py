@@ -16,6 +16,8 @@ counted as an error; geometry (offsets, axes, origin rotations) is quantised by 
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from .chain import Chain
@@ -23,6 +25,17 @@ from .model import Model, formats
 from .oracle import PinChain
 
 METRICS = ("pos", "rot", "jac", "jac_tool", "qnorm")
+
+#: the measurement published in docs/numerics.md and enforced by the tests
+SAMPLES = 10_000
+SEED = 1
+#: accuracy goals of the default configuration (issue: FK 5 um / 10 urad, Jacobian 1e-5)
+GOALS = {"pos": 5e-6, "rot": 10e-6, "jac": 1e-5, "jac_tool": 1e-5}
+#: bounds every example chain must meet (about twice the worst measured; docs/numerics.md)
+BOUNDS = {
+    "default": {"pos": 3e-6, "rot": 2e-6, "jac": 3e-6, "jac_tool": 4e-6},
+    "compact": {"pos": 1e-3, "rot": 1e-3, "jac": 1e-3, "jac_tool": 2e-3},
+}
 
 
 def rotation_angle(Ra: np.ndarray, Rb: np.ndarray) -> np.ndarray:
@@ -62,3 +75,11 @@ def measure(chain: Chain, config: str, samples: int = 10000, seed: int = 1) -> d
         "qnorm": float(np.abs(np.linalg.norm(jb.quat[:, -1], axis=-1) - 1.0).max()),
         "overflow": int((jb.overflow | jt.overflow).sum()),
     }
+
+
+@functools.lru_cache(maxsize=None)
+def measure_example(name: str, config: str) -> dict[str, float]:
+    """``measure`` on an embedded example with the published sample count and seed (cached)."""
+    from . import robots
+
+    return measure(robots.load(name), config, SAMPLES, SEED)

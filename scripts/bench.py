@@ -1,0 +1,138 @@
+#!/usr/bin/env python3
+"""``make bench``: benchmark tables, peers measured in the same run.
+
+    .venv/bin/python scripts/bench.py [--only kin ...] [--seconds S] [--no-write]
+
+Sections (each prints a table and, unless --no-write, rewrites its section of docs/benchmarks.md):
+  kin   FK of every frame + tool Jacobian per call: the C++ model (double, default, compact) vs
+        Pinocchio C++ (computeFrameJacobian, LOCAL_WORLD_ALIGNED), same chains, same joint values
+"""
+from __future__ import annotations
+
+import argparse
+import datetime
+import os
+import platform
+import re
+import subprocess
+import sys
+import sysconfig
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "model" / "python"))
+
+from tensor_servo import robots  # noqa: E402
+from tensor_servo.model import model_spec  # noqa: E402
+
+BUILD = ROOT / "build" / "bench"
+DOC = ROOT / "docs" / "benchmarks.md"
+KIN_CHAINS = ["puma560", "ur5", "stanford", "panda", "chain20"]
+
+
+def cpu_name() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or "unknown CPU"
+
+
+def pin_prefix() -> Path:
+    return Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix"
+
+
+def build_bench_kin() -> Path:
+    exe = BUILD / "bench_kin"
+    src = ROOT / "model" / "bench" / "bench_kin.cpp"
+    hdrs = list((ROOT / "model" / "include" / "tensor_servo").glob("*.hpp"))
+    if exe.exists() and all(exe.stat().st_mtime > p.stat().st_mtime for p in [src, *hdrs]):
+        return exe
+    BUILD.mkdir(parents=True, exist_ok=True)
+    # Pinocchio header-only (its templates instantiated here, -O3 -march=native like ours);
+    # the BOOST_MPL limits are the ones Pinocchio's CMake config exports.
+    cmd = ["g++", "-std=c++17", "-O3", "-march=native", "-DNDEBUG", "-w",
+           "-DBOOST_MPL_LIMIT_LIST_SIZE=30", "-DBOOST_MPL_LIMIT_VECTOR_SIZE=30",
+           "-DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS", "-DBOOST_FUSION_INVOKE_MAX_ARITY=12",
+           "-I/usr/include/eigen3", f"-I{pin_prefix() / 'include'}", f"-I{ROOT / 'model' / 'include'}",
+           str(src), "-o", str(exe)]
+    print("bench: compiling", exe.relative_to(ROOT), "(Pinocchio headers: about a minute)", flush=True)
+    subprocess.run(cmd, check=True)
+    return exe
+
+
+def write_spec_txt(name: str, path: Path) -> None:
+    s = model_spec(robots.load(name))
+    f = lambda v: " ".join(repr(float(x)) for x in v)  # noqa: E731
+    lines = [str(len(s["joints"])), f(s["base_quat"]) + " " + f(s["base_xyz"]), f(s["tool_quat"]) + " " + f(s["tool_xyz"])]
+    for j in s["joints"]:
+        lines.append(" ".join([str(int(j["prismatic"])), f(j["origin_quat"]), f(j["origin_xyz"]), f(j["axis"]),
+                               repr(j["scale"]), str(int(j["limited"])), repr(j["lower"]), repr(j["upper"])]))
+    path.write_text("\n".join(lines) + "\n")
+
+
+def bench_kin(seconds: float) -> str:
+    exe = build_bench_kin()
+    rows = []
+    for name in KIN_CHAINS:
+        spec = BUILD / f"{name}.txt"
+        write_spec_txt(name, spec)
+        out = subprocess.run([str(exe), str(spec), str(seconds)], check=True, capture_output=True, text=True).stdout
+        res = {}
+        for line in out.splitlines():
+            parts = line.split()
+            if len(parts) >= 3:
+                res[parts[0]] = float(parts[1])  # min over 7 repeats, ns per call
+        n = robots.load(name).n
+        rows.append((name, n, res))
+    hdr = ("| chain | DOF | Pinocchio ns/call | tservo double ns/call | double / Pinocchio | "
+           "tservo default ns/call (calls/s) | tservo compact ns/call (calls/s) |")
+    lines = [hdr, "|---|---|---|---|---|---|---|"]
+    for name, n, r in rows:
+        p, d, fd, fc = r["pinocchio"], r["tservo-double"], r["tservo-default"], r["tservo-compact"]
+        lines.append(f"| {name} | {n} | {p:.0f} | {d:.0f} | {d / p:.2f} | {fd:.0f} ({1e9 / fd:,.0f}) | {fc:.0f} ({1e9 / fc:,.0f}) |")
+    table = "\n".join(lines)
+    ratios = [r["tservo-double"] / r["pinocchio"] for nm, _, r in rows if nm in ("puma560", "panda", "chain20")]
+    six = [r for nm, n, r in rows if n == 6]
+    verdict = [
+        f"- Goal: the double model within 1.5x of Pinocchio (PUMA 560, Panda, chain20): worst ratio "
+        f"{max(ratios):.2f} -> {'met' if max(ratios) <= 1.5 else 'NOT met'}.",
+        f"- Goal: fixed-point model >= 500,000 FK+Jacobian per second for 6 DOF on one core: slowest 6-DOF "
+        f"default {min(1e9 / r['tservo-default'] for r in six):,.0f}/s -> "
+        f"{'met' if min(1e9 / r['tservo-default'] for r in six) >= 5e5 else 'NOT met'}.",
+    ]
+    return table + "\n\n" + "\n".join(verdict)
+
+
+SECTIONS = {"kin": bench_kin}
+
+
+def replace_section(text: str, name: str, body: str) -> str:
+    pat = re.compile(rf"(<!-- BEGIN {name} -->).*?(<!-- END {name} -->)", re.S)
+    if not pat.search(text):
+        return text.rstrip() + f"\n\n<!-- BEGIN {name} -->\n{body}\n<!-- END {name} -->\n"
+    return pat.sub(lambda m: m.group(1) + "\n" + body + "\n" + m.group(2), text)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--only", nargs="*", choices=list(SECTIONS), default=list(SECTIONS))
+    ap.add_argument("--seconds", type=float, default=1.0, help="time per measured case")
+    ap.add_argument("--no-write", action="store_true", help="print only, leave docs/benchmarks.md alone")
+    a = ap.parse_args()
+    stamp = (f"Measured {datetime.date.today().isoformat()} on {cpu_name()} ({os.cpu_count()} cores), "
+             f"command `make bench` (`.venv/bin/python scripts/bench.py`).")
+    text = DOC.read_text() if DOC.exists() else "# Benchmarks\n"
+    for name in a.only:
+        body = stamp + "\n\n" + SECTIONS[name](a.seconds)
+        print(f"\n== {name} ==\n{body}\n", flush=True)
+        text = replace_section(text, name, body)
+    if not a.no_write:
+        DOC.write_text(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
