@@ -22,6 +22,9 @@
 #include <cmath>
 #include <cstdint>
 #include <type_traits>
+#ifdef TS_TRACE  // debugging aid: print every saturation (type, flag, value) to stderr
+#include <cstdio>
+#endif
 
 namespace ts {
 
@@ -141,6 +144,9 @@ template <class Dst, int W, int I, uint32_t L>
 inline Dst cvt(fx<W, I, L> x, Status& st) {
   static_assert(Dst::F - (W - I) < 62, "widening shift too large");
   const int64_t r = detail::round_raw(x.raw, W - I, Dst::F);
+#ifdef TS_TRACE
+  if (r > Dst::RAW_MAX || r < Dst::RAW_MIN) std::fprintf(stderr, "saturate to <%d,%d> flag %x: %g\n", Dst::W, Dst::I, Dst::FLAG, x.to_double());
+#endif
   if (r > Dst::RAW_MAX) { st.raise(Dst::FLAG); return Dst::from_raw(Dst::RAW_MAX); }
   if (r < Dst::RAW_MIN) { st.raise(Dst::FLAG); return Dst::from_raw(Dst::RAW_MIN); }
   return Dst::from_raw(r);

@@ -121,10 +121,12 @@ inline void solver_prepare(const SolverParams<Fmt, NMAX>& P, const Jacobian<Fmt,
     C.lo[i] = vmin; C.hi[i] = vmax;
     C.lo_pos[i] = C.hi_pos[i] = false;
     if (P.limited[i]) {
-      const qd_t plo = cvt<qd_t>(P.klim * (P.lo[i] - q[i]), st);
-      const qd_t phi = cvt<qd_t>(P.klim * (P.hi[i] - q[i]), st);
-      if (vmin < plo) { C.lo[i] = tmin(plo, vmax); C.lo_pos[i] = true; }
-      if (phi < vmax) { C.hi[i] = tmax(phi, vmin); C.hi_pos[i] = true; }
+      // Compared exactly before narrowing: a bound beyond the velocity interval is inactive and
+      // never needs to be represented (no spurious saturation for wide ranges or large klim).
+      const auto plo = P.klim * (P.lo[i] - q[i]);
+      const auto phi = P.klim * (P.hi[i] - q[i]);
+      if (vmin < plo) { C.lo[i] = vmax < plo ? vmax : cvt<qd_t>(plo, st); C.lo_pos[i] = true; }
+      if (phi < vmax) { C.hi[i] = phi < vmin ? vmin : cvt<qd_t>(phi, st); C.hi_pos[i] = true; }
     }
   }
 }

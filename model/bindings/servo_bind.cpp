@@ -1,0 +1,228 @@
+// Python bindings of the servo tick (solver + servo law) and of the virtual-mode IK loop.
+//
+//   s = _model.Servo(config, chain_spec, params)
+//   s.tick(q, U_quat, U_pos, U_w, U_v, qd_warm)         one tick, float in / float + raw out
+//   s.tick_raw(q_raw, U_quat_raw, U_pos_raw, U_w_raw, U_v_raw, qd_warm_raw)
+//   s.ik(q0 (N,n), T_quat (N,4), T_pos (N,3), max_ticks, tol_pos, tol_rot)
+//
+// params (dict): L, kp, ko, dt, klim (floats), sweeps (int), mu (list of n floats), vlimits (bool:
+// apply the chain's velocity limits),
+// mode ("A" | "B"), feedforward (bool), controlled (frame index, -1 = tool),
+// setpoint_frame (-1 = root, k = frame k of the chain).
+#include "common.hpp"
+#include "tensor_servo/servo.hpp"
+
+namespace py = pybind11;
+using namespace pybind11::literals;
+using namespace ts;
+using namespace tsbind;
+
+namespace {
+
+struct ServoBase {
+  virtual ~ServoBase() = default;
+  virtual int n() const = 0;
+  virtual py::dict tick(const py::array& q, const py::array& uq, const py::array& up, const py::array& uw,
+                        const py::array& uv, const py::array& qd_warm, bool raw) const = 0;
+  virtual py::dict ik(const f64arr& q0, const f64arr& tq, const f64arr& tp, int max_ticks, double tol_pos,
+                      double tol_rot) const = 0;
+  virtual py::dict params_raw() const = 0;
+};
+
+template <class T> T param(const py::dict& d, const char* key, Status& st) {
+  const double v = d[key].cast<double>();
+  Status s;
+  const T r = from_double<T>(v, s);
+  if (s.overflow()) throw std::invalid_argument(std::string(key) + ": " + std::to_string(v) + " outside its format");
+  st.flags |= s.flags;
+  return r;
+}
+
+template <class Fmt>
+struct Servo final : ServoBase {
+  using angle_t = typename Fmt::angle_t;
+  using quat_t = typename Fmt::quat_t;
+  using pos_t = typename Fmt::pos_t;
+  using vel_t = typename Fmt::vel_t;
+  using qd_t = typename Fmt::qd_t;
+  ChainQ<Fmt, NMAX> ch;
+  ServoParams<Fmt, NMAX> P;
+
+  Servo(const ChainSpec& spec, const py::dict& pd) {
+    const ConfigResult r = quantize<Fmt, NMAX>(spec, ch);
+    if (!r.ok()) throw std::invalid_argument(r.field + ": " + r.message);
+    Status st;
+    auto& S = P.solver;
+    S.L = param<typename Fmt::lchar_t>(pd, "L", st);
+    if (!(to_double(S.L) > 0)) throw std::invalid_argument("L: must be positive");
+    S.klim = param<typename Fmt::klim_t>(pd, "klim", st);
+    S.sweeps = pd["sweeps"].cast<int>();
+    if (S.sweeps < 1 || S.sweeps > 1000) throw std::invalid_argument("sweeps: must be 1..1000");
+    const auto mu = pd["mu"].cast<std::vector<double>>();
+    if (static_cast<int>(mu.size()) != ch.n) throw std::invalid_argument("mu: one value per joint");
+    const bool vlimits = pd["vlimits"].cast<bool>();
+    for (int i = 0; i < ch.n; ++i) {
+      const JointSpec& j = spec.joints[i];
+      Status s;
+      S.mu[i] = from_double<typename Fmt::mu_t>(mu[i], s);
+      if (s.overflow() || mu[i] < 0) throw std::invalid_argument("mu: must lie in [0, 2)");
+      S.limited[i] = j.limited;
+      S.lo[i] = from_double<angle_t>(j.limited ? j.lower : 0.0, st);
+      S.hi[i] = from_double<angle_t>(j.limited ? j.upper : 0.0, st);
+      if (vlimits && j.velocity > 0) {
+        S.vmax[i] = from_double<qd_t>(j.velocity, s);
+        if (s.overflow()) throw std::invalid_argument("joints[" + std::to_string(i) + "].limits.velocity: outside the joint-rate format");
+      } else {
+        S.vmax[i] = max_of<qd_t>();
+      }
+    }
+    P.kp = param<typename Fmt::gain_t>(pd, "kp", st);
+    P.ko = param<typename Fmt::gain_t>(pd, "ko", st);
+    P.dt = param<typename Fmt::dt_t>(pd, "dt", st);
+    if (!(to_double(P.dt) > 0)) throw std::invalid_argument("dt: must be positive");
+    const std::string mode = pd["mode"].cast<std::string>();
+    if (mode != "A" && mode != "B") throw std::invalid_argument("mode: 'A' or 'B'");
+    P.mode = mode == "A" ? ERR_A : ERR_B;
+    P.feedforward = pd["feedforward"].cast<bool>();
+    P.controlled = pd["controlled"].cast<int>();
+    P.setpoint_frame = pd["setpoint_frame"].cast<int>();
+    if (P.controlled < -1 || P.controlled == 0 || P.controlled > ch.n + 1) throw std::invalid_argument("controlled: frame 1..n+1 or -1 (tool)");
+    const int ctl = P.controlled < 0 ? ch.n + 1 : P.controlled;
+    if (P.setpoint_frame < -1 || P.setpoint_frame >= ctl) throw std::invalid_argument("setpoint_frame: -1 or a frame before the controlled one");
+  }
+  int n() const override { return ch.n; }
+
+  template <class T, int N>
+  static void load(const py::array& a, bool raw, T* out, const char* name, py::ssize_t row = -1) {
+    const py::ssize_t off = row < 0 ? 0 : row * N;
+    if (raw) {
+      if constexpr (Fmt::is_float) throw std::invalid_argument("raw input needs a fixed-point configuration");
+      else for (int k = 0; k < N; ++k) out[k] = T::from_raw(static_cast<const int64_t*>(a.data())[off + k]);
+    } else {
+      Status s;
+      for (int k = 0; k < N; ++k) out[k] = from_double<T>(static_cast<const double*>(a.data())[off + k], s);
+      if (s.overflow()) throw std::invalid_argument(std::string(name) + ": value outside its format");
+    }
+    (void)name;
+  }
+  py::array as(const py::array& a, bool raw) const {
+    return raw ? py::array(i64arr::ensure(a)) : py::array(f64arr::ensure(a));
+  }
+
+  py::dict tick(const py::array& q_in, const py::array& uq_in, const py::array& up_in, const py::array& uw_in,
+                const py::array& uv_in, const py::array& w_in, bool raw) const override {
+    const int n = ch.n;
+    const py::array q = as(q_in, raw), uq = as(uq_in, raw), up = as(up_in, raw), uw = as(uw_in, raw),
+                    uv = as(uv_in, raw), w = as(w_in, raw);
+    need_shape(q, {n}, "q"); need_shape(uq, {4}, "U_quat"); need_shape(up, {3}, "U_pos");
+    need_shape(uw, {3}, "U_w"); need_shape(uv, {3}, "U_v"); need_shape(w, {n}, "qd_warm");
+    angle_t qq[NMAX]; qd_t warm[NMAX];
+    Setpoint<Fmt> U;
+    Status st;
+    for (int i = 0; i < n; ++i)
+      qq[i] = raw ? of_raw<angle_t>(static_cast<const int64_t*>(q.data())[i])
+                  : from_double<angle_t>(static_cast<const double*>(q.data())[i], st);
+    load<quat_t, 4>(uq, raw, U.Q.c, "U_quat");
+    load<pos_t, 3>(up, raw, U.p.c, "U_pos");
+    load<vel_t, 3>(uw, raw, U.w.c, "U_w");
+    load<vel_t, 3>(uv, raw, U.v.c, "U_v");
+    for (int i = 0; i < n; ++i)
+      warm[i] = raw ? of_raw<qd_t>(static_cast<const int64_t*>(w.data())[i])
+                    : from_double<qd_t>(static_cast<const double*>(w.data())[i], st);
+    auto R = std::make_unique<TickResult<Fmt, NMAX>>();
+    servo_tick(ch, P, qq, U, warm, *R, st);
+    f64arr qd(shp(n)), qn(shp(n)), ep(shp(3)), eo(shp(3)), r(shp(6));
+    i64arr qd_r(shp(n)), qn_r(shp(n)), ep_r(shp(3)), eo_r(shp(3)), r_r(shp(6));
+    for (int i = 0; i < n; ++i) {
+      qd.mutable_at(i) = to_double(R->qd[i]); qd_r.mutable_at(i) = raw_of(R->qd[i]);
+      qn.mutable_at(i) = to_double(R->q_next[i]); qn_r.mutable_at(i) = raw_of(R->q_next[i]);
+    }
+    for (int a = 0; a < 3; ++a) {
+      ep.mutable_at(a) = to_double(R->ep.c[a]); ep_r.mutable_at(a) = raw_of(R->ep.c[a]);
+      eo.mutable_at(a) = to_double(R->eo.c[a]); eo_r.mutable_at(a) = raw_of(R->eo.c[a]);
+    }
+    for (int a = 0; a < 6; ++a) { r.mutable_at(a) = to_double(R->r[a]); r_r.mutable_at(a) = raw_of(R->r[a]); }
+    py::dict d("qd"_a = qd, "q_next"_a = qn, "ep"_a = ep, "eo"_a = eo, "r"_a = r, "flags"_a = st.flags);
+    if (!Fmt::is_float) {
+      d["qd_raw"] = qd_r; d["q_next_raw"] = qn_r; d["ep_raw"] = ep_r; d["eo_raw"] = eo_r; d["r_raw"] = r_r;
+    }
+    return d;
+  }
+
+  // Virtual-mode IK: run ticks towards each target (U' = 0) from q0 until the model's own errors
+  // are within tolerance (checked before each move) or max_ticks.
+  py::dict ik(const f64arr& q0, const f64arr& tq, const f64arr& tp, int max_ticks, double tol_pos,
+              double tol_rot) const override {
+    const int n = ch.n;
+    need_shape(q0, {-1, n}, "q0");
+    const py::ssize_t N = q0.shape(0);
+    need_shape(tq, {N, 4}, "T_quat"); need_shape(tp, {N, 3}, "T_pos");
+    f64arr qo(shp(N, n)); py::array_t<int32_t> ticks(N); py::array_t<bool> conv(N); u32arr flags(N);
+    auto R = std::make_unique<TickResult<Fmt, NMAX>>();
+    for (py::ssize_t s = 0; s < N; ++s) {
+      Status st;
+      angle_t qq[NMAX]; qd_t warm[NMAX];
+      for (int i = 0; i < n; ++i) { qq[i] = from_double<angle_t>(q0.at(s, i), st); warm[i] = qd_t{}; }
+      Setpoint<Fmt> U;
+      for (int a = 0; a < 4; ++a) U.Q.c[a] = from_double<quat_t>(tq.at(s, a), st);
+      for (int a = 0; a < 3; ++a) { U.p.c[a] = from_double<pos_t>(tp.at(s, a), st); U.w.c[a] = vel_t{}; U.v.c[a] = vel_t{}; }
+      int t = 0;
+      bool ok = false;
+      for (; t <= max_ticks; ++t) {
+        servo_tick(ch, P, qq, U, warm, *R, st);
+        double ep = 0, eo = 0;
+        for (int a = 0; a < 3; ++a) {
+          ep = std::max(ep, std::fabs(to_double(R->ep.c[a])));
+          eo = std::max(eo, std::fabs(to_double(R->eo.c[a])));
+        }
+        if (ep <= tol_pos && eo <= tol_rot) { ok = true; break; }
+        if (t == max_ticks) break;
+        for (int i = 0; i < n; ++i) { qq[i] = R->q_next[i]; warm[i] = R->qd[i]; }
+      }
+      for (int i = 0; i < n; ++i) qo.mutable_at(s, i) = to_double(qq[i]);
+      ticks.mutable_at(s) = t;
+      conv.mutable_at(s) = ok;
+      flags.mutable_at(s) = st.flags;
+    }
+    return py::dict("q"_a = qo, "ticks"_a = ticks, "converged"_a = conv, "flags"_a = flags);
+  }
+
+  py::dict params_raw() const override {
+    const int n = ch.n;
+    i64arr mu(shp(n)), lo(shp(n)), hi(shp(n)), vmax(shp(n));
+    py::array_t<bool> lim(n);
+    for (int i = 0; i < n; ++i) {
+      mu.mutable_at(i) = raw_of(P.solver.mu[i]); lo.mutable_at(i) = raw_of(P.solver.lo[i]);
+      hi.mutable_at(i) = raw_of(P.solver.hi[i]); vmax.mutable_at(i) = raw_of(P.solver.vmax[i]);
+      lim.mutable_at(i) = P.solver.limited[i];
+    }
+    return py::dict("L"_a = raw_of(P.solver.L), "klim"_a = raw_of(P.solver.klim), "sweeps"_a = P.solver.sweeps,
+                    "mu"_a = mu, "lo"_a = lo, "hi"_a = hi, "vmax"_a = vmax, "limited"_a = lim,
+                    "kp"_a = raw_of(P.kp), "ko"_a = raw_of(P.ko), "dt"_a = raw_of(P.dt), "mode"_a = P.mode,
+                    "feedforward"_a = P.feedforward, "controlled"_a = P.controlled,
+                    "setpoint_frame"_a = P.setpoint_frame);
+  }
+};
+
+std::unique_ptr<ServoBase> make_servo(const std::string& cfg, const py::dict& spec, const py::dict& params) {
+  const ChainSpec c = spec_from_dict(spec);
+  if (cfg == "double") return std::make_unique<Servo<FmtDouble>>(c, params);
+  if (cfg == "default") return std::make_unique<Servo<FmtDefault>>(c, params);
+  if (cfg == "compact") return std::make_unique<Servo<FmtCompact>>(c, params);
+  throw std::invalid_argument("config: unknown configuration '" + cfg + "' (double, default, compact)");
+}
+
+}  // namespace
+
+void bind_servo(py::module_& m) {
+  py::class_<ServoBase>(m, "Servo")
+      .def(py::init(&make_servo), py::arg("config"), py::arg("spec"), py::arg("params"))
+      .def_property_readonly("n", &ServoBase::n)
+      .def("tick", [](const ServoBase& s, const py::array& q, const py::array& uq, const py::array& up,
+                      const py::array& uw, const py::array& uv, const py::array& w) { return s.tick(q, uq, up, uw, uv, w, false); })
+      .def("tick_raw", [](const ServoBase& s, const py::array& q, const py::array& uq, const py::array& up,
+                          const py::array& uw, const py::array& uv, const py::array& w) { return s.tick(q, uq, up, uw, uv, w, true); })
+      .def("ik", &ServoBase::ik, py::arg("q0"), py::arg("T_quat"), py::arg("T_pos"), py::arg("max_ticks"),
+           py::arg("tol_pos"), py::arg("tol_rot"))
+      .def("params_raw", &ServoBase::params_raw);
+}
