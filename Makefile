@@ -73,9 +73,10 @@ $(BUILD)/bindings/%.o: model/bindings/%.cpp | $(STAMP_VENV)
 	@mkdir -p $(@D)
 	$(CXX) $(CXXSTD) $(CXXOPT) $(CXXWARN) $(DEPFLAGS) -fPIC -fvisibility=hidden $(INCLUDES) $(PYBIND) -c $< -o $@
 
+# Linked to a temporary name and renamed, so a concurrent import never sees a missing module.
 $(BIND_STAMP): $(BIND_OBJS)
-	rm -f $(PKG)/_model.*.so
-	$(CXX) -shared $^ -o $(PKG)/_model$(PYEXT)
+	$(CXX) -shared $^ -o $(PKG)/.tmp_model$(PYEXT)
+	mv -f $(PKG)/.tmp_model$(PYEXT) $(PKG)/_model$(PYEXT)
 	@touch $@
 
 -include $(wildcard $(BUILD)/model_tests/*.d $(BUILD)/bindings/*.d)

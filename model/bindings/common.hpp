@@ -65,8 +65,18 @@ inline ChainSpec spec_from_dict(const py::dict& d) {
     j.lower = jd["lower"].cast<double>();
     j.upper = jd["upper"].cast<double>();
     j.velocity = jd["velocity"].cast<double>();
+    if (jd.contains("parent")) j.parent = jd["parent"].cast<int>();
     c.joints.push_back(j);
   }
+  if (d.contains("tips"))
+    for (const auto& th : d["tips"].cast<py::list>()) {
+      const py::dict td = th.cast<py::dict>();
+      TipSpec t;
+      t.parent = td["parent"].cast<int>();
+      arr(td["quat"], t.quat, 4, "tips.quat");
+      arr(td["xyz"], t.xyz, 3, "tips.xyz");
+      c.tips.push_back(t);
+    }
   return c;
 }
 

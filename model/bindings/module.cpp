@@ -85,7 +85,7 @@ struct Model final : ModelBase {
   py::dict fk(const py::array& q_in, bool raw) const override {
     const py::array q = prepare(q_in, raw);
     const py::ssize_t N = q.shape(0);
-    const int nf = ch.n + 2;
+    const int nf = ch.n + 1 + ch.ntips;
     f64arr quat(shp(N, nf, 4)), pos(shp(N, nf, 3)), axis(shp(N, ch.n, 3));
     i64arr quat_r(shp(N, nf, 4)), pos_r(shp(N, nf, 3)), axis_r(shp(N, ch.n, 3));
     u32arr flags(N);
@@ -114,10 +114,10 @@ struct Model final : ModelBase {
   py::dict jacobian(const py::array& q_in, bool raw, int ref, int basis) const override {
     const py::array q = prepare(q_in, raw);
     const py::ssize_t N = q.shape(0);
-    const int nf = ch.n + 2;
+    const int nf = ch.n + 1 + ch.ntips;
     if (ref < 0) ref = ch.n + 1;
-    if (ref < 1 || ref > ch.n + 1) throw std::invalid_argument("ref: frame index outside 1..n+1");
-    if (basis < -1 || basis > ch.n + 1) throw std::invalid_argument("basis: frame index outside -1..n+1");
+    if (ref < 1 || ref > ch.n + ch.ntips) throw std::invalid_argument("ref: frame index outside 1..n+tips");
+    if (basis < -1 || basis > ch.n + ch.ntips) throw std::invalid_argument("basis: frame index outside -1..n+tips");
     f64arr J(shp(N, 6, ch.n)), quat(shp(N, nf, 4)), pos(shp(N, nf, 3));
     i64arr J_r(shp(N, 6, ch.n)), quat_r(shp(N, nf, 4)), pos_r(shp(N, nf, 3));
     u32arr flags(N);
@@ -161,8 +161,21 @@ struct Model final : ModelBase {
       k.mutable_at(i) = raw_of(j.k);
       pr.mutable_at(i) = j.prismatic;
     }
-    for (int a = 0; a < 4; ++a) { qb.mutable_at(a) = raw_of(ch.qb.c[a]); qt.mutable_at(a) = raw_of(ch.qt.c[a]); }
-    for (int a = 0; a < 3; ++a) { pb.mutable_at(a) = raw_of(ch.pb.c[a]); pt.mutable_at(a) = raw_of(ch.pt.c[a]); }
+    for (int a = 0; a < 4; ++a) { qb.mutable_at(a) = raw_of(ch.qb.c[a]); qt.mutable_at(a) = raw_of(ch.qt[0].c[a]); }
+    for (int a = 0; a < 3; ++a) { pb.mutable_at(a) = raw_of(ch.pb.c[a]); pt.mutable_at(a) = raw_of(ch.pt[0].c[a]); }
+    py::array_t<int32_t> parent(n), tip_parent(ch.ntips);
+    i64arr tq(shp(ch.ntips, 4)), tp(shp(ch.ntips, 3));
+    for (int i = 0; i < n; ++i) parent.mutable_at(i) = ch.parent[i];
+    for (int t = 0; t < ch.ntips; ++t) {
+      tip_parent.mutable_at(t) = ch.tip_parent[t];
+      for (int a = 0; a < 4; ++a) tq.mutable_at(t, a) = raw_of(ch.qt[t].c[a]);
+      for (int a = 0; a < 3; ++a) tp.mutable_at(t, a) = raw_of(ch.pt[t].c[a]);
+    }
+    const bool serial = ch.ntips == 1 && tip_parent.at(0) == n && [&] { for (int i = 0; i < n; ++i) if (ch.parent[i] != i) return false; return true; }();
+    if (!serial)
+      return py::dict("origin_quat"_a = qo, "origin_xyz"_a = po, "axis"_a = ax, "scale"_a = s, "kturn"_a = k,
+                      "prismatic"_a = pr, "base_quat"_a = qb, "base_xyz"_a = pb, "parent_frame"_a = parent,
+                      "tip_parent_frame"_a = tip_parent, "tip_quat"_a = tq, "tip_xyz"_a = tp);
     return py::dict("origin_quat"_a = qo, "origin_xyz"_a = po, "axis"_a = ax, "scale"_a = s, "kturn"_a = k,
                     "prismatic"_a = pr, "base_quat"_a = qb, "base_xyz"_a = pb, "tool_quat"_a = qt, "tool_xyz"_a = pt);
   }

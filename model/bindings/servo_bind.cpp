@@ -1,13 +1,14 @@
 // Python bindings of the servo tick (solver + servo law) and of the virtual-mode IK loop.
 //
 //   s = _model.Servo(config, chain_spec, params)
-//   s.tick(q, U_quat, U_pos, U_w, U_v, qd_warm)         one tick, float in / float + raw out
+//   s.tick(q, U_quat (T,4), U_pos (T,3), U_w (T,3), U_v (T,3), qd_warm)   one tick, T tasks
 //   s.tick_raw(q_raw, U_quat_raw, U_pos_raw, U_w_raw, U_v_raw, qd_warm_raw)
 //   s.ik(q0 (N,n), T_quat (N,4), T_pos (N,3), max_ticks, tol_pos, tol_rot)
 //
 // params (dict): L, kp, ko, dt, klim (floats), sweeps (int), mu (list of n floats), vlimits (bool:
 // apply the chain's velocity limits),
-// mode ("A" | "B"), feedforward (bool), controlled (frame index, -1 = tool),
+// mode ("A" | "B"), feedforward (bool), controlled (list of frame indices, one per task; -1 = tip t),
+// weights (list, one per task),
 // setpoint_frame (-1 = root, k = frame k of the chain).
 #include "common.hpp"
 #include "tensor_servo/servo.hpp"
@@ -46,7 +47,7 @@ struct Servo final : ServoBase {
   using vel_t = typename Fmt::vel_t;
   using qd_t = typename Fmt::qd_t;
   ChainQ<Fmt, NMAX> ch;
-  ServoParams<Fmt, NMAX> P;
+  ServoParams<Fmt, NMAX> P;  // TMAX = 4 tasks (trees of chains)
 
   Servo(const ChainSpec& spec, const py::dict& pd) {
     const ConfigResult r = quantize<Fmt, NMAX>(spec, ch);
@@ -67,8 +68,9 @@ struct Servo final : ServoBase {
       S.mu[i] = from_double<typename Fmt::mu_t>(mu[i], s);
       if (s.overflow() || mu[i] < 0) throw std::invalid_argument("mu: must lie in [0, 2)");
       S.limited[i] = j.limited;
-      S.lo[i] = from_double<angle_t>(j.limited ? j.lower : 0.0, st);
-      S.hi[i] = from_double<angle_t>(j.limited ? j.upper : 0.0, st);
+      // limits rounded inward: a joint value within the quantised limits is within the true ones
+      S.lo[i] = from_double_dir<angle_t>(j.limited ? j.lower : 0.0, true, st);
+      S.hi[i] = from_double_dir<angle_t>(j.limited ? j.upper : 0.0, false, st);
       if (vlimits && j.velocity > 0) {
         S.vmax[i] = from_double<qd_t>(j.velocity, s);
         if (s.overflow()) throw std::invalid_argument("joints[" + std::to_string(i) + "].limits.velocity: outside the joint-rate format");
@@ -84,11 +86,30 @@ struct Servo final : ServoBase {
     if (mode != "A" && mode != "B") throw std::invalid_argument("mode: 'A' or 'B'");
     P.mode = mode == "A" ? ERR_A : ERR_B;
     P.feedforward = pd["feedforward"].cast<bool>();
-    P.controlled = pd["controlled"].cast<int>();
+    // Tasks: "controlled" is a list of frame indices (-1: tip t); "weights" one per task.
+    const auto ctl = pd["controlled"].cast<std::vector<int>>();
+    const auto wts = pd["weights"].cast<std::vector<double>>();
+    P.ntasks = static_cast<int>(ctl.size());
+    if (P.ntasks < 1 || P.ntasks > 4 || wts.size() != ctl.size())
+      throw std::invalid_argument("controlled: 1..4 tasks, one weight each");
+    const int nf = ch.n + ch.ntips;
     P.setpoint_frame = pd["setpoint_frame"].cast<int>();
-    if (P.controlled < -1 || P.controlled == 0 || P.controlled > ch.n + 1) throw std::invalid_argument("controlled: frame 1..n+1 or -1 (tool)");
-    const int ctl = P.controlled < 0 ? ch.n + 1 : P.controlled;
-    if (P.setpoint_frame < -1 || P.setpoint_frame >= ctl) throw std::invalid_argument("setpoint_frame: -1 or a frame before the controlled one");
+    for (int t = 0; t < P.ntasks; ++t) {
+      P.controlled[t] = ctl[t];
+      if (ctl[t] < -1 || ctl[t] == 0 || ctl[t] > nf) throw std::invalid_argument("controlled: frame 1..n+tips or -1 (tip)");
+      if (ctl[t] < 0 && t >= ch.ntips) throw std::invalid_argument("controlled: task " + std::to_string(t) + " has no tip");
+      Status s;
+      P.weight[t] = from_double<typename Fmt::weight_t>(wts[t], s);
+      if (s.overflow() || wts[t] < 0) throw std::invalid_argument("weights: must lie in [0, 4)");
+      // the setpoint frame must be an ancestor of every controlled frame
+      const int c = ctl[t] < 0 ? ch.n + 1 + t : ctl[t];
+      if (P.setpoint_frame >= 0) {
+        int f = c;
+        while (f > P.setpoint_frame) f = ch.parent_frame(f);
+        if (f != P.setpoint_frame) throw std::invalid_argument("setpoint_frame: must be a frame the controlled frame hangs from");
+      }
+    }
+    if (P.setpoint_frame < -1 || P.setpoint_frame > ch.n) throw std::invalid_argument("setpoint_frame: -1 or a frame 0..n");
   }
   int n() const override { return ch.n; }
 
@@ -109,39 +130,43 @@ struct Servo final : ServoBase {
     return raw ? py::array(i64arr::ensure(a)) : py::array(f64arr::ensure(a));
   }
 
+  // U arrays: (T,4), (T,3), (T,3), (T,3) for T = ntasks setpoints.
   py::dict tick(const py::array& q_in, const py::array& uq_in, const py::array& up_in, const py::array& uw_in,
                 const py::array& uv_in, const py::array& w_in, bool raw) const override {
-    const int n = ch.n;
+    const int n = ch.n, T = P.ntasks;
     const py::array q = as(q_in, raw), uq = as(uq_in, raw), up = as(up_in, raw), uw = as(uw_in, raw),
                     uv = as(uv_in, raw), w = as(w_in, raw);
-    need_shape(q, {n}, "q"); need_shape(uq, {4}, "U_quat"); need_shape(up, {3}, "U_pos");
-    need_shape(uw, {3}, "U_w"); need_shape(uv, {3}, "U_v"); need_shape(w, {n}, "qd_warm");
+    need_shape(q, {n}, "q"); need_shape(uq, {T, 4}, "U_quat"); need_shape(up, {T, 3}, "U_pos");
+    need_shape(uw, {T, 3}, "U_w"); need_shape(uv, {T, 3}, "U_v"); need_shape(w, {n}, "qd_warm");
     angle_t qq[NMAX]; qd_t warm[NMAX];
-    Setpoint<Fmt> U;
+    Setpoint<Fmt> U[4];
     Status st;
     for (int i = 0; i < n; ++i)
       qq[i] = raw ? of_raw<angle_t>(static_cast<const int64_t*>(q.data())[i])
                   : from_double<angle_t>(static_cast<const double*>(q.data())[i], st);
-    load<quat_t, 4>(uq, raw, U.Q.c, "U_quat");
-    load<pos_t, 3>(up, raw, U.p.c, "U_pos");
-    load<vel_t, 3>(uw, raw, U.w.c, "U_w");
-    load<vel_t, 3>(uv, raw, U.v.c, "U_v");
+    for (int t = 0; t < T; ++t) {
+      load<quat_t, 4>(uq, raw, U[t].Q.c, "U_quat", t);
+      load<pos_t, 3>(up, raw, U[t].p.c, "U_pos", t);
+      load<vel_t, 3>(uw, raw, U[t].w.c, "U_w", t);
+      load<vel_t, 3>(uv, raw, U[t].v.c, "U_v", t);
+    }
     for (int i = 0; i < n; ++i)
       warm[i] = raw ? of_raw<qd_t>(static_cast<const int64_t*>(w.data())[i])
                     : from_double<qd_t>(static_cast<const double*>(w.data())[i], st);
     auto R = std::make_unique<TickResult<Fmt, NMAX>>();
     servo_tick(ch, P, qq, U, warm, *R, st);
-    f64arr qd(shp(n)), qn(shp(n)), ep(shp(3)), eo(shp(3)), r(shp(6));
-    i64arr qd_r(shp(n)), qn_r(shp(n)), ep_r(shp(3)), eo_r(shp(3)), r_r(shp(6));
+    f64arr qd(shp(n)), qn(shp(n)), ep(shp(T, 3)), eo(shp(T, 3)), r(shp(6 * T));
+    i64arr qd_r(shp(n)), qn_r(shp(n)), ep_r(shp(T, 3)), eo_r(shp(T, 3)), r_r(shp(6 * T));
     for (int i = 0; i < n; ++i) {
       qd.mutable_at(i) = to_double(R->qd[i]); qd_r.mutable_at(i) = raw_of(R->qd[i]);
       qn.mutable_at(i) = to_double(R->q_next[i]); qn_r.mutable_at(i) = raw_of(R->q_next[i]);
     }
-    for (int a = 0; a < 3; ++a) {
-      ep.mutable_at(a) = to_double(R->ep.c[a]); ep_r.mutable_at(a) = raw_of(R->ep.c[a]);
-      eo.mutable_at(a) = to_double(R->eo.c[a]); eo_r.mutable_at(a) = raw_of(R->eo.c[a]);
-    }
-    for (int a = 0; a < 6; ++a) { r.mutable_at(a) = to_double(R->r[a]); r_r.mutable_at(a) = raw_of(R->r[a]); }
+    for (int t = 0; t < T; ++t)
+      for (int a = 0; a < 3; ++a) {
+        ep.mutable_at(t, a) = to_double(R->ep[t].c[a]); ep_r.mutable_at(t, a) = raw_of(R->ep[t].c[a]);
+        eo.mutable_at(t, a) = to_double(R->eo[t].c[a]); eo_r.mutable_at(t, a) = raw_of(R->eo[t].c[a]);
+      }
+    for (int a = 0; a < 6 * T; ++a) { r.mutable_at(a) = to_double(R->r[a]); r_r.mutable_at(a) = raw_of(R->r[a]); }
     py::dict d("qd"_a = qd, "q_next"_a = qn, "ep"_a = ep, "eo"_a = eo, "r"_a = r, "flags"_a = st.flags);
     if (!Fmt::is_float) {
       d["qd_raw"] = qd_r; d["q_next_raw"] = qn_r; d["ep_raw"] = ep_r; d["eo_raw"] = eo_r; d["r_raw"] = r_r;
@@ -154,6 +179,7 @@ struct Servo final : ServoBase {
   py::dict ik(const f64arr& q0, const f64arr& tq, const f64arr& tp, int max_ticks, double tol_pos,
               double tol_rot) const override {
     const int n = ch.n;
+    if (P.ntasks != 1) throw std::invalid_argument("ik: one task (use tick() for several tips)");
     need_shape(q0, {-1, n}, "q0");
     const py::ssize_t N = q0.shape(0);
     need_shape(tq, {N, 4}, "T_quat"); need_shape(tp, {N, 3}, "T_pos");
@@ -169,11 +195,11 @@ struct Servo final : ServoBase {
       int t = 0;
       bool ok = false;
       for (; t <= max_ticks; ++t) {
-        servo_tick(ch, P, qq, U, warm, *R, st);
+        servo_tick(ch, P, qq, &U, warm, *R, st);
         double ep = 0, eo = 0;
         for (int a = 0; a < 3; ++a) {
-          ep = std::max(ep, std::fabs(to_double(R->ep.c[a])));
-          eo = std::max(eo, std::fabs(to_double(R->eo.c[a])));
+          ep = std::max(ep, std::fabs(to_double(R->ep[0].c[a])));
+          eo = std::max(eo, std::fabs(to_double(R->eo[0].c[a])));
         }
         if (ep <= tol_pos && eo <= tol_rot) { ok = true; break; }
         if (t == max_ticks) break;
@@ -199,7 +225,7 @@ struct Servo final : ServoBase {
     return py::dict("L"_a = raw_of(P.solver.L), "klim"_a = raw_of(P.solver.klim), "sweeps"_a = P.solver.sweeps,
                     "mu"_a = mu, "lo"_a = lo, "hi"_a = hi, "vmax"_a = vmax, "limited"_a = lim,
                     "kp"_a = raw_of(P.kp), "ko"_a = raw_of(P.ko), "dt"_a = raw_of(P.dt), "mode"_a = P.mode,
-                    "feedforward"_a = P.feedforward, "controlled"_a = P.controlled,
+                    "feedforward"_a = P.feedforward, "ntasks"_a = P.ntasks,
                     "setpoint_frame"_a = P.setpoint_frame);
   }
 };

@@ -21,6 +21,8 @@
 namespace ts {
 
 struct JointSpec {
+  int parent = -2;                       // -2: the previous joint (serial); -1: the base frame;
+                                         // k >= 0: joint k (k < this joint's index)
   bool prismatic = false;
   double origin_quat[4] = {1, 0, 0, 0};  // w, x, y, z (unit)
   double origin_xyz[3] = {0, 0, 0};
@@ -31,12 +33,20 @@ struct JointSpec {
   double velocity = 0.0;                 // joint units per second (0: none)
 };
 
+// A tip: a frame fixed to a joint frame (a tree of chains has several; a serial chain has the tool).
+struct TipSpec {
+  int parent = -1;                       // joint index (-1: the last joint)
+  double quat[4] = {1, 0, 0, 0};
+  double xyz[3] = {0, 0, 0};
+};
+
 struct ChainSpec {
   double base_quat[4] = {1, 0, 0, 0};
   double base_xyz[3] = {0, 0, 0};
-  double tool_quat[4] = {1, 0, 0, 0};
+  double tool_quat[4] = {1, 0, 0, 0};    // the single tip when `tips` is empty
   double tool_xyz[3] = {0, 0, 0};
   std::vector<JointSpec> joints;
+  std::vector<TipSpec> tips;             // trees of chains (seed section 12); empty: serial + tool
 };
 
 // Configuration error codes, shared with the RTL core's CFG_ERROR register.
@@ -50,6 +60,7 @@ enum ConfigError : int {
   CFG_OFFSET = 6,        // an offset outside the length format
   CFG_REACH = 7,         // the chain could drive a position / lever / Jacobian entry out of range
   CFG_TYPE = 8,          // unknown joint type (RTL register field)
+  CFG_TREE = 9,          // a parent index not before its joint, or too many tips
 };
 
 struct ConfigResult {
@@ -71,13 +82,22 @@ struct JointQ {
   typename Fmt::kturn_t k;              // s / (4 pi): joint unit -> half-angle turns
 };
 
-template <class Fmt, int NMAX>
+// Frame indices: 0 = base, 1..n = joint frames (after motion), n+1..n+ntips = tips (n+1 = tool).
+template <class Fmt, int NMAX, int TMAX = 4>
 struct ChainQ {
   static constexpr int nmax = NMAX;
+  static constexpr int tmax = TMAX;
   int n = 0;
-  Quat<typename Fmt::quat_t> qb, qt;    // base and tool rotation
-  Vec3<typename Fmt::len_t> pb, pt;     // base and tool translation
+  int ntips = 1;
+  Quat<typename Fmt::quat_t> qb;        // base rotation
+  Vec3<typename Fmt::len_t> pb;         // base translation
   JointQ<Fmt> j[NMAX];
+  int parent[NMAX];                     // frame index of joint j's parent frame (serial: j)
+  Quat<typename Fmt::quat_t> qt[TMAX];  // tip rotations (relative to their parent joint frame)
+  Vec3<typename Fmt::len_t> pt[TMAX];
+  int tip_parent[TMAX];                 // frame index (1..n) of each tip's joint frame
+  // The frame a frame index hangs from: joint frame i -> parent[i-1], tip -> its joint frame.
+  int parent_frame(int f) const { return f > n ? tip_parent[f - n - 1] : parent[f - 1]; }
 };
 
 namespace detail {
@@ -105,9 +125,12 @@ inline void quant_array(const double* src, T* dst, Status& st) {
 constexpr double kUnitTol = 1e-6;
 
 // Bound on the distance between two frame origins of the chain (from the first joint frame on):
-// sum of origin offsets, tool offset and prismatic strokes.
+// sum of all origin offsets and prismatic strokes plus the longest tip offset (for a tree this
+// sums every branch: conservative).
 inline double chain_reach(const ChainSpec& c) {
-  double r = detail::norm3(c.tool_xyz);
+  double r = 0;
+  if (c.tips.empty()) r = detail::norm3(c.tool_xyz);
+  for (const auto& t : c.tips) r = std::max(r, detail::norm3(t.xyz));
   for (const auto& j : c.joints) {
     r += detail::norm3(j.origin_xyz);
     if (j.prismatic) r += std::fabs(j.scale) * std::max(std::fabs(j.lower), std::fabs(j.upper));
@@ -115,8 +138,8 @@ inline double chain_reach(const ChainSpec& c) {
   return r;
 }
 
-template <class Fmt, int NMAX>
-inline ConfigResult quantize(const ChainSpec& c, ChainQ<Fmt, NMAX>& out) {
+template <class Fmt, int NMAX, int TMAX>
+inline ConfigResult quantize(const ChainSpec& c, ChainQ<Fmt, NMAX, TMAX>& out) {
   using quat_t = typename Fmt::quat_t;
   using len_t = typename Fmt::len_t;
   using angle_t = typename Fmt::angle_t;
@@ -145,10 +168,20 @@ inline ConfigResult quantize(const ChainSpec& c, ChainQ<Fmt, NMAX>& out) {
   for (auto r : {check_quat(c.base_quat, -1, "base.quat_wxyz"), check_quat(c.tool_quat, -1, "tool.quat_wxyz"),
                  check_off(c.base_xyz, -1, "base.xyz"), check_off(c.tool_xyz, -1, "tool.xyz")})
     if (!r.ok()) return r;
+  const int ntips = c.tips.empty() ? 1 : static_cast<int>(c.tips.size());
+  if (ntips > TMAX)
+    return fail(CFG_TREE, -1, "tips", "chain has " + std::to_string(ntips) + " tips; this build handles 1.." + std::to_string(TMAX));
+  for (int t = 0; t < static_cast<int>(c.tips.size()); ++t) {
+    const std::string pre = "tips[" + std::to_string(t) + "].";
+    if (auto r = check_quat(c.tips[t].quat, -1, pre + "quat_wxyz"); !r.ok()) return r;
+    if (auto r = check_off(c.tips[t].xyz, -1, pre + "xyz"); !r.ok()) return r;
+    if (c.tips[t].parent < -1 || c.tips[t].parent >= n) return fail(CFG_TREE, -1, pre + "parent", "no such joint");
+  }
   double smax = 0.0;
   for (int i = 0; i < n; ++i) {
     const JointSpec& js = c.joints[i];
     const std::string pre = "joints[" + std::to_string(i) + "].";
+    if (js.parent < -2 || js.parent >= i) return fail(CFG_TREE, i, pre + "parent", "the parent must be an earlier joint or the base");
     if (auto r = check_quat(js.origin_quat, i, pre + "origin.quat_wxyz"); !r.ok()) return r;
     if (auto r = check_off(js.origin_xyz, i, pre + "origin.xyz"); !r.ok()) return r;
     if (std::fabs(detail::norm3(js.axis) - 1.0) > kUnitTol)
@@ -179,12 +212,22 @@ inline ConfigResult quantize(const ChainSpec& c, ChainQ<Fmt, NMAX>& out) {
 
   Status st;
   out.n = n;
+  out.ntips = ntips;
   detail::quant_array<quat_t, 4>(c.base_quat, out.qb.c, st);
-  detail::quant_array<quat_t, 4>(c.tool_quat, out.qt.c, st);
   detail::quant_array<len_t, 3>(c.base_xyz, out.pb.c, st);
-  detail::quant_array<len_t, 3>(c.tool_xyz, out.pt.c, st);
+  if (c.tips.empty()) {
+    detail::quant_array<quat_t, 4>(c.tool_quat, out.qt[0].c, st);
+    detail::quant_array<len_t, 3>(c.tool_xyz, out.pt[0].c, st);
+    out.tip_parent[0] = n;
+  }
+  for (int t = 0; t < static_cast<int>(c.tips.size()); ++t) {
+    detail::quant_array<quat_t, 4>(c.tips[t].quat, out.qt[t].c, st);
+    detail::quant_array<len_t, 3>(c.tips[t].xyz, out.pt[t].c, st);
+    out.tip_parent[t] = c.tips[t].parent < 0 ? n : c.tips[t].parent + 1;
+  }
   for (int i = 0; i < n; ++i) {
     const JointSpec& js = c.joints[i];
+    out.parent[i] = js.parent == -2 ? i : js.parent + 1;
     JointQ<Fmt>& q = out.j[i];
     q.prismatic = js.prismatic;
     detail::quant_array<quat_t, 4>(js.origin_quat, q.qo.c, st);

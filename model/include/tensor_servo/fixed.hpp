@@ -81,6 +81,14 @@ struct fx {
     if (s < static_cast<double>(RAW_MIN)) { st.raise(FLAG ? FLAG : ST_OVF_CONST); return from_raw(RAW_MIN); }
     return from_raw(static_cast<int64_t>(s));
   }
+  // Directed quantisation (configuration constants such as joint limits, which must be rounded
+  // inward so that a value inside the quantised limits is inside the true ones).  Saturating.
+  static fx from_double_dir(double d, bool up, Status& st) {
+    const double s = up ? std::ceil(std::ldexp(d, F)) : std::floor(std::ldexp(d, F));
+    if (!(s <= static_cast<double>(RAW_MAX))) { st.raise(FLAG ? FLAG : ST_OVF_CONST); return from_raw(std::isnan(d) ? 0 : RAW_MAX); }
+    if (s < static_cast<double>(RAW_MIN)) { st.raise(FLAG ? FLAG : ST_OVF_CONST); return from_raw(RAW_MIN); }
+    return from_raw(static_cast<int64_t>(s));
+  }
   // True when d lies inside the representable range after rounding (no saturation would occur).
   static bool representable(double d) {
     const double s = std::floor(std::ldexp(d, F) + 0.5);
@@ -215,6 +223,13 @@ template <class T>
 inline T from_double(double d, Status& st) {
   if constexpr (std::is_same_v<T, double>) { (void)st; return d; }
   else return T::from_double(d, st);
+}
+
+// Inward-rounded limits: lower rounded up, upper rounded down (identity for double).
+template <class T>
+inline T from_double_dir(double d, bool up, Status& st) {
+  if constexpr (std::is_same_v<T, double>) { (void)up; (void)st; return d; }
+  else return T::from_double_dir(d, up, st);
 }
 
 // Comparisons on exact values (formats may differ).

@@ -56,6 +56,7 @@ struct FmtDouble {
   using rot_t = double;
   using rvf_t = double;
   using tacc_t = double;
+  using weight_t = double;
   static constexpr int RECIP_TABLE_BITS = 6;
   static constexpr int ROTVEC_TABLE_BITS = 6;
 };
@@ -105,6 +106,7 @@ struct FmtDefault {
   using rot_t = fx<27, 3, ST_OVF_SERVO>;       // orientation error, rotation vector (rad), |.| <= pi
   using rvf_t = fx<27, 2, ST_OVF_SERVO>;       // phi / sin(phi) table for the rotation vector, [1, pi/2]
   using tacc_t = fx<60, 17, ST_OVF_SOLVER>;    // exact accumulator of Vs - sum Js_i q'_i (n <= 64)
+  using weight_t = fx<18, 3, ST_OVF_CONST>;    // per-task row weight (trees of chains), [0, 4)
   static constexpr int RECIP_TABLE_BITS = 6;
   static constexpr int ROTVEC_TABLE_BITS = 6;
 };
@@ -151,6 +153,7 @@ struct FmtCompact {
   using rot_t = fx<18, 3, ST_OVF_SERVO>;
   using rvf_t = fx<18, 2, ST_OVF_SERVO>;
   using tacc_t = fx<42, 17, ST_OVF_SOLVER>;
+  using weight_t = fx<18, 3, ST_OVF_CONST>;
   static constexpr int RECIP_TABLE_BITS = 6;
   static constexpr int ROTVEC_TABLE_BITS = 6;
 };

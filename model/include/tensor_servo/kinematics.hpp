@@ -1,23 +1,24 @@
 // tensor-servo: forward kinematics of every frame and the Jacobian by screw transport.
 //
 // Frames: 0 = base (the first joint's parent frame), i = 1..n = the frame of joint i after its
-// motion, n+1 = tool.  All poses are in the root frame (the URDF's base link): quaternion Q_k and
+// motion, n+1.. = tips (n+1 = the tool of a serial chain).  A joint's parent frame is the previous
+// joint's (serial chain) or any earlier frame (a tree of chains, seed section 12).  All poses are in the root frame (the URDF's base link): quaternion Q_k and
 // origin p_k.
 //
-// Per joint i (joint index j = i-1), from frame i-1:
-//     QF  = Q_{i-1} (x) Qo_i                 joint frame before motion
-//     pF  = p_{i-1} + R(Q_{i-1}) po_i
+// Per joint i (joint index j = i-1), from its parent frame P (serial: i-1):
+//     QF  = Q_P (x) Qo_i                     joint frame before motion
+//     pF  = p_P + R(Q_P) po_i
 //     z_i = R(QF) a_i                        joint axis in the root basis (unit)
 //   revolute:  u = wrap(q_j * s/(4 pi))  (half angle, turns);  (c, s) = sincos(u)
 //              Q_i = QF (x) (c, s a_i),  p_i = pF
 //   prismatic: d = s q_j;  Q_i = QF,  p_i = pF + d z_i
-// Tool: Q_{n+1} = Q_n (x) Qt, p_{n+1} = p_n + R(Q_n) pt.
+// Tip t on joint frame P: Q_{n+1+t} = Q_P (x) Qt_t, p_{n+1+t} = p_P + R(Q_P) pt_t.
 //
 // Jacobian column i for the reference point p_ref (origin of frame `ref`), twist order (omega; v),
 // in the root basis -- the seed's W_i = (s a_i; 0) carried by screw transport:
 //   revolute:  omega = s z_i,  v = omega x (p_ref - p_i)
 //   prismatic: omega = 0,      v = s z_i
-// and zero for joints after `ref`.  In the basis of frame b both halves are rotated by conj(Q_b).
+// and zero for joints that do not move frame `ref` (serial: joints after it).  In the basis of frame b both halves are rotated by conj(Q_b).
 //
 // No drift: the pose is recomputed from q every tick, so rounding errors never accumulate over
 // time; their bound grows only with the number of joints (docs/numerics.md).
@@ -26,13 +27,14 @@
 
 namespace ts {
 
-template <class Fmt, int NMAX>
+template <class Fmt, int NMAX, int TMAX = 4>
 struct Frames {
-  static constexpr int nframes_max = NMAX + 2;
+  static constexpr int nframes_max = NMAX + 1 + TMAX;
   int n = 0;
-  Quat<typename Fmt::quat_t> Q[NMAX + 2];
-  Vec3<typename Fmt::pos_t> p[NMAX + 2];
-  Vec3<typename Fmt::quat_t> z[NMAX + 2];  // z[i]: axis of joint i (1..n), root basis
+  int ntips = 1;
+  Quat<typename Fmt::quat_t> Q[NMAX + 1 + TMAX];
+  Vec3<typename Fmt::pos_t> p[NMAX + 1 + TMAX];
+  Vec3<typename Fmt::quat_t> z[NMAX + 1];  // z[i]: axis of joint i (1..n), root basis
 };
 
 template <class Fmt, int NMAX>
@@ -55,9 +57,9 @@ inline Quat<typename Fmt::quat_t> joint_quat(const JointQ<Fmt>& jq, typename Fmt
   return r;
 }
 
-template <class Fmt, int NMAX>
-inline void forward_kinematics(const ChainQ<Fmt, NMAX>& ch, const typename Fmt::angle_t* q,
-                               Frames<Fmt, NMAX>& f, Status& st) {
+template <class Fmt, int NMAX, int TMAX>
+inline void forward_kinematics(const ChainQ<Fmt, NMAX, TMAX>& ch, const typename Fmt::angle_t* q,
+                               Frames<Fmt, NMAX, TMAX>& f, Status& st) {
   using quat_t = typename Fmt::quat_t;
   using pos_t = typename Fmt::pos_t;
   using len_tmp_t = typename Fmt::len_tmp_t;
@@ -65,13 +67,15 @@ inline void forward_kinematics(const ChainQ<Fmt, NMAX>& ch, const typename Fmt::
   using lever_t = typename Fmt::lever_t;
   const int n = ch.n;
   f.n = n;
+  f.ntips = ch.ntips;
   f.Q[0] = ch.qb;
   f.p[0] = vec_cvt<pos_t>(ch.pb, st);  // exact widening
   for (int i = 1; i <= n; ++i) {
     const JointQ<Fmt>& jq = ch.j[i - 1];
-    const Quat<quat_t> QF = qmul<quat_t>(f.Q[i - 1], jq.qo, st);
-    const Vec3<pos_t> off = rotate<pos_t, len_tmp_t>(f.Q[i - 1], jq.po, st);
-    const Vec3<pos_t> pF = vadd<pos_t>(f.p[i - 1], off, st);
+    const int pf = ch.parent[i - 1];  // serial chain: i - 1
+    const Quat<quat_t> QF = qmul<quat_t>(f.Q[pf], jq.qo, st);
+    const Vec3<pos_t> off = rotate<pos_t, len_tmp_t>(f.Q[pf], jq.po, st);
+    const Vec3<pos_t> pF = vadd<pos_t>(f.p[pf], off, st);
     f.z[i] = rotate<quat_t, uvec_tmp_t>(QF, jq.axis, st);
     if (!jq.prismatic) {
       f.Q[i] = qmul<quat_t>(QF, joint_quat<Fmt>(jq, q[i - 1], st), st);
@@ -82,9 +86,22 @@ inline void forward_kinematics(const ChainQ<Fmt, NMAX>& ch, const typename Fmt::
       for (int a = 0; a < 3; ++a) f.p[i].c[a] = cvt<pos_t>(pF.c[a] + d * f.z[i].c[a], st);
     }
   }
-  f.Q[n + 1] = qmul<quat_t>(f.Q[n], ch.qt, st);
-  const Vec3<pos_t> off = rotate<pos_t, len_tmp_t>(f.Q[n], ch.pt, st);
-  f.p[n + 1] = vadd<pos_t>(f.p[n], off, st);
+  for (int t = 0; t < ch.ntips; ++t) {
+    const int pf = ch.tip_parent[t];  // serial chain: the tool on frame n
+    f.Q[n + 1 + t] = qmul<quat_t>(f.Q[pf], ch.qt[t], st);
+    const Vec3<pos_t> off = rotate<pos_t, len_tmp_t>(f.Q[pf], ch.pt[t], st);
+    f.p[n + 1 + t] = vadd<pos_t>(f.p[pf], off, st);
+  }
+}
+
+// Mark the joints that move frame f (its ancestors): on_path[j] for joint j (0-based).
+template <class Fmt, int NMAX, int TMAX>
+inline void joints_moving(const ChainQ<Fmt, NMAX, TMAX>& ch, int f, bool* on_path) {
+  for (int j = 0; j < ch.n; ++j) on_path[j] = false;
+  while (f >= 1) {
+    if (f <= ch.n) on_path[f - 1] = true;
+    f = ch.parent_frame(f);
+  }
 }
 
 // One Jacobian column by screw transport (root basis), reference point p_ref.
@@ -104,18 +121,21 @@ inline void screw_column(bool prismatic, typename Fmt::scale_t s, const Vec3<typ
   }
 }
 
-// Basis: -1 = root frame axes, otherwise a frame index 0..n+1.  ref: frame index 1..n+1.
-template <class Fmt, int NMAX>
-inline void jacobian(const ChainQ<Fmt, NMAX>& ch, const Frames<Fmt, NMAX>& f, int ref, int basis,
+// Basis: -1 = root frame axes, otherwise a frame index 0..n+ntips.  ref: frame index 1..n+ntips.
+// Columns of joints that do not move frame `ref` are zero (serial chain: joints after ref).
+template <class Fmt, int NMAX, int TMAX>
+inline void jacobian(const ChainQ<Fmt, NMAX, TMAX>& ch, const Frames<Fmt, NMAX, TMAX>& f, int ref, int basis,
                      Jacobian<Fmt, NMAX>& J, Status& st) {
   using jw_t = typename Fmt::jw_t;
   using jv_t = typename Fmt::jv_t;
   const int n = ch.n;
   J.n = n;
+  bool moves[NMAX];
+  joints_moving(ch, ref, moves);
   for (int i = 1; i <= n; ++i) {
     Vec3<jw_t>& w = J.w[i - 1];
     Vec3<jv_t>& v = J.v[i - 1];
-    if (i > ref) {
+    if (!moves[i - 1]) {
       for (int a = 0; a < 3; ++a) { w.c[a] = jw_t{}; v.c[a] = jv_t{}; }
       continue;
     }

@@ -13,8 +13,11 @@
 //     (the feed-forward twist carried from U's origin to P's and into P's axes: Ad_{E_b} V_U^b)
 // Error-only mode (the seed's alternative): U' is not fed forward.
 // Moving local basis (seed section 11): the setpoint may be given relative to frame k of the chain.
-// Then P is replaced by T_k^-1 P, the Jacobian is taken in frame k's axes and its columns 1..k are
-// zero (joints up to k move frame k and the controlled frame together).
+// Then P is replaced by T_k^-1 P, the Jacobian is taken in frame k's axes and the columns of the
+// joints that move frame k are zero (they move frame k and the controlled frame together).
+// Trees of chains (seed section 12): several tasks (one per tip), each with its own setpoint, are
+// stacked into one least-squares problem over the shared joints, each task's rows scaled by its
+// weight w_t (so its squared error counts w_t^2).
 //
 // Rotation vector without a divider: for a unit quaternion (w, u) with w >= 0 (sign flipped
 // otherwise), rotvec = 2 f(w) u with f(w) = acos(w) / sqrt(1 - w^2) = (phi/2) / sin(phi/2), taken
@@ -70,15 +73,18 @@ inline Vec3<typename Fmt::rot_t> rotvec(Quat<typename Fmt::quat_t> q, Status& st
   return r;
 }
 
-template <class Fmt, int NMAX>
+template <class Fmt, int NMAX, int TMAX = 4>
 struct ServoParams {
   SolverParams<Fmt, NMAX> solver;
   typename Fmt::gain_t kp, ko;      // position and orientation gains (1/s)
   typename Fmt::dt_t dt;            // tick period (s), used in virtual mode
   int mode = ERR_A;
   bool feedforward = true;          // false: the seed's error-only mode
-  int controlled = -1;              // frame whose pose is servoed (-1: tool)
+  int ntasks = 1;                   // controlled frames stacked in one solve (trees: one per tip)
+  int controlled[TMAX];             // frame of each task; -1: tip t (the tool for task 0)
+  typename Fmt::weight_t weight[TMAX];  // row weight of each task (used when ntasks > 1)
   int setpoint_frame = -1;          // -1: U in the root frame; k: U relative to frame k
+  ServoParams() { for (int t = 0; t < TMAX; ++t) controlled[t] = -1; }
 };
 
 template <class Fmt>
@@ -88,33 +94,30 @@ struct Setpoint {
   Vec3<typename Fmt::vel_t> w, v;   // twist (omega; v): v of the controlled point, axes as for e
 };
 
-template <class Fmt, int NMAX>
+template <class Fmt, int NMAX, int TMAX = 4>
 struct TickResult {
   typename Fmt::qd_t qd[NMAX];      // joint-rate command
   typename Fmt::angle_t q_next[NMAX];  // q + q' dt, clamped to the limits (virtual mode)
-  Vec3<typename Fmt::perr_t> ep;    // position error
-  Vec3<typename Fmt::rot_t> eo;     // orientation error (rotation vector)
-  typename Fmt::tw_t r[6];          // final scaled residual of the solver
-  Frames<Fmt, NMAX> frames;
-  Jacobian<Fmt, NMAX> J;
+  Vec3<typename Fmt::perr_t> ep[TMAX];  // position error of each task
+  Vec3<typename Fmt::rot_t> eo[TMAX];   // orientation error (rotation vector) of each task
+  typename Fmt::tw_t r[6 * TMAX];   // final scaled residual of the solver
+  Frames<Fmt, NMAX, TMAX> frames;
+  Jacobian<Fmt, NMAX> J[TMAX];
 };
 
-// One servo tick.  qd_warm: the previous tick's q' (warm start).
-template <class Fmt, int NMAX>
-inline void servo_tick(const ChainQ<Fmt, NMAX>& ch, const ServoParams<Fmt, NMAX>& P,
-                       const typename Fmt::angle_t* q, const Setpoint<Fmt>& U, const typename Fmt::qd_t* qd_warm,
-                       TickResult<Fmt, NMAX>& R, Status& st) {
+// Error and commanded twist of one task (controlled frame ctl, setpoint U); fills the task's
+// Jacobian in the matching basis.
+template <class Fmt, int NMAX, int TMAX>
+inline void task_error(const ChainQ<Fmt, NMAX, TMAX>& ch, const ServoParams<Fmt, NMAX, TMAX>& P,
+                       const Frames<Fmt, NMAX, TMAX>& f, int ctl, const Setpoint<Fmt>& U,
+                       Vec3<typename Fmt::perr_t>& ep, Vec3<typename Fmt::rot_t>& eo,
+                       Vec3<typename Fmt::vel_t>& V_w, Vec3<typename Fmt::vel_t>& V_v, Jacobian<Fmt, NMAX>& J,
+                       Status& st) {
   using quat_t = typename Fmt::quat_t;
   using pos_t = typename Fmt::pos_t;
   using perr_t = typename Fmt::perr_t;
   using vel_t = typename Fmt::vel_t;
-  using tw_t = typename Fmt::tw_t;
-  const int n = ch.n;
-  const int ctl = P.controlled < 0 ? n + 1 : P.controlled;
   const int k = P.setpoint_frame;
-  forward_kinematics(ch, q, R.frames, st);
-  const Frames<Fmt, NMAX>& f = R.frames;
-
   // Pose of the controlled frame, relative to the setpoint frame when one is given.
   Quat<quat_t> QP = f.Q[ctl];
   Vec3<pos_t> pP = f.p[ctl];
@@ -124,22 +127,18 @@ inline void servo_tick(const ChainQ<Fmt, NMAX>& ch, const ServoParams<Fmt, NMAX>
     pP = rotate<pos_t, typename Fmt::len_tmp_t, true>(f.Q[k], d, st);
   }
   const Vec3<perr_t> dp = vsub<perr_t>(U.p, pP, st);  // p_U - p_P, setpoint axes
-  Vec3<vel_t> V_w, V_v;
-  int basis;
   if (P.mode == ERR_A) {
-    basis = k;  // root (-1) or frame k
-    R.ep = dp;
-    R.eo = rotvec<Fmt>(qmul<quat_t>(U.Q, conj(QP, st), st), st);
+    ep = dp;
+    eo = rotvec<Fmt>(qmul<quat_t>(U.Q, conj(QP, st), st), st);
     for (int a = 0; a < 3; ++a) {
-      const auto fw = P.ko * R.eo.c[a];
-      const auto fv = P.kp * R.ep.c[a];
+      const auto fw = P.ko * eo.c[a];
+      const auto fv = P.kp * ep.c[a];
       V_w.c[a] = P.feedforward ? cvt<vel_t>(U.w.c[a] + fw, st) : cvt<vel_t>(fw, st);
       V_v.c[a] = P.feedforward ? cvt<vel_t>(U.v.c[a] + fv, st) : cvt<vel_t>(fv, st);
     }
   } else {
-    basis = ctl;
-    R.ep = rotate<perr_t, typename Fmt::len_tmp_t, true>(QP, dp, st);
-    R.eo = rotvec<Fmt>(qmul<quat_t>(conj(QP, st), U.Q, st), st);
+    ep = rotate<perr_t, typename Fmt::len_tmp_t, true>(QP, dp, st);
+    eo = rotvec<Fmt>(qmul<quat_t>(conj(QP, st), U.Q, st), st);
     Vec3<vel_t> ffw{}, ffv{};
     if (P.feedforward) {
       // omega_U x (p_P - p_U) = dp x omega_U
@@ -149,26 +148,53 @@ inline void servo_tick(const ChainQ<Fmt, NMAX>& ch, const ServoParams<Fmt, NMAX>
       ffv = rotate<vel_t, typename Fmt::jv_tmp_t, true>(QP, vP, st);
     }
     for (int a = 0; a < 3; ++a) {
-      V_w.c[a] = cvt<vel_t>(ffw.c[a] + P.ko * R.eo.c[a], st);
-      V_v.c[a] = cvt<vel_t>(ffv.c[a] + P.kp * R.ep.c[a], st);
+      V_w.c[a] = cvt<vel_t>(ffw.c[a] + P.ko * eo.c[a], st);
+      V_v.c[a] = cvt<vel_t>(ffv.c[a] + P.kp * ep.c[a], st);
     }
   }
-  // Jacobian of the controlled frame's origin; in frame k (moving local basis) or the body basis
-  // when a frame is given, the root otherwise.  With a setpoint frame, joints 1..k do not move P
-  // relative to frame k: their columns are zero.
-  jacobian(ch, f, ctl, basis < 0 ? -1 : (P.mode == ERR_A ? k : ctl), R.J, st);
-  if (k >= 1)
-    for (int i = 0; i < k && i < n; ++i)
-      for (int a = 0; a < 3; ++a) { R.J.w[i].c[a] = typename Fmt::jw_t{}; R.J.v[i].c[a] = typename Fmt::jv_t{}; }
-
-  // Scaled target and the solve.
-  tw_t vs[6];
-  for (int a = 0; a < 3; ++a) {
-    vs[a] = cvt<tw_t>(P.solver.L * V_w.c[a], st);
-    vs[a + 3] = cvt<tw_t>(V_v.c[a], st);
+  // Jacobian of the controlled frame's origin: root axes (A, no setpoint frame), frame k's axes
+  // (A, moving local basis), or the controlled frame's own axes (B).  With a setpoint frame k,
+  // the joints that move frame k move the controlled frame with it: their columns are zero.
+  const int basis = P.mode == ERR_B ? ctl : k;
+  jacobian(ch, f, ctl, basis, J, st);
+  if (k >= 1) {
+    bool moves_k[NMAX];
+    joints_moving(ch, k, moves_k);
+    for (int i = 0; i < ch.n; ++i)
+      if (moves_k[i])
+        for (int a = 0; a < 3; ++a) { J.w[i].c[a] = typename Fmt::jw_t{}; J.v[i].c[a] = typename Fmt::jv_t{}; }
   }
-  SolverColumns<Fmt, NMAX> C;
-  solver_prepare(P.solver, R.J, q, C, st);
+}
+
+// One servo tick.  U: one setpoint per task; qd_warm: the previous tick's q' (warm start).
+template <class Fmt, int NMAX, int TMAX>
+inline void servo_tick(const ChainQ<Fmt, NMAX, TMAX>& ch, const ServoParams<Fmt, NMAX, TMAX>& P,
+                       const typename Fmt::angle_t* q, const Setpoint<Fmt>* U, const typename Fmt::qd_t* qd_warm,
+                       TickResult<Fmt, NMAX, TMAX>& R, Status& st) {
+  using vel_t = typename Fmt::vel_t;
+  using tw_t = typename Fmt::tw_t;
+  const int n = ch.n;
+  const int T = P.ntasks;
+  forward_kinematics(ch, q, R.frames, st);
+
+  SolverColumns<Fmt, NMAX, 6 * TMAX> C;
+  C.rows = 6 * T;
+  tw_t vs[6 * TMAX];
+  for (int t = 0; t < T; ++t) {
+    const int ctl = P.controlled[t] < 0 ? n + 1 + t : P.controlled[t];
+    Vec3<vel_t> V_w, V_v;
+    task_error(ch, P, R.frames, ctl, U[t], R.ep[t], R.eo[t], V_w, V_v, R.J[t], st);
+    // Scaled (and, for several tasks, weighted) target and columns of this task.
+    const typename Fmt::weight_t* w = T > 1 ? &P.weight[t] : nullptr;
+    typename Fmt::lchar_t L = P.solver.L;
+    if (w) L = cvt<typename Fmt::lchar_t>(P.solver.L * *w, st);
+    for (int a = 0; a < 3; ++a) {
+      vs[6 * t + a] = cvt<tw_t>(L * V_w.c[a], st);
+      vs[6 * t + a + 3] = w ? cvt<tw_t>(*w * V_v.c[a], st) : cvt<tw_t>(V_v.c[a], st);
+    }
+    solver_columns(P.solver, R.J[t], t, w, C, st);
+  }
+  solver_steps(P.solver, q, n, C, st);
   for (int i = 0; i < n; ++i) R.qd[i] = qd_warm[i];
   solver_run(P.solver, C, n, vs, R.qd, R.r, st);
 

@@ -45,10 +45,12 @@ struct SolverParams {
   int sweeps = 2;
 };
 
-// Per-column quantities computed once per tick.
-template <class Fmt, int NMAX>
+// Per-column quantities computed once per tick.  ROWS = 6 x (number of stacked tasks); a serial
+// chain with one controlled frame has 6.
+template <class Fmt, int NMAX, int ROWS = 6>
 struct SolverColumns {
-  typename Fmt::jsc_t js[NMAX][6];         // scaled columns (L omega; v)
+  int rows = 6;                            // rows in use (6 per task)
+  typename Fmt::jsc_t js[NMAX][ROWS];      // scaled columns (L omega; v) per task, stacked
   typename Fmt::step_t c[NMAX];            // mu_i / mant_i
   int k[NMAX];                             // normalisation exponent of d_i
   typename Fmt::qd_t lo[NMAX], hi[NMAX];   // bounds of q'_i this tick
@@ -69,6 +71,23 @@ struct RecipTable {
     return t;
   }
 };
+
+// Exact sum of m products a[i] b[i] (m <= 32): the accumulator has 5 more integer bits than one
+// product, so no rounding and no overflow can occur (the RTL uses the same width).
+template <class A, class B>
+inline auto dot_exact(const A* a, const B* b, int m) {
+  if constexpr (std::is_same_v<A, double>) {
+    double acc = 0;
+    for (int i = 0; i < m; ++i) acc += a[i] * b[i];
+    return acc;
+  } else {
+    using P = decltype(a[0] * b[0]);
+    using Acc = fx<P::W + 5, P::I + 5>;
+    Acc acc{};
+    for (int i = 0; i < m; ++i) acc = Acc::from_raw(acc.raw + (a[i] * b[i]).raw * (int64_t(1) << (Acc::F - P::F)));
+    return acc;
+  }
+}
 
 // Step factor c = mu / d and the exponent k with d = m 2^k, m in [1, 2).  d <= 0 gives c = 0.
 template <class Fmt, class D>
@@ -99,21 +118,29 @@ inline void step_factor(const D& d, typename Fmt::mu_t mu, typename Fmt::step_t&
 template <class T> inline T tmin(const T& a, const T& b) { return b < a ? b : a; }
 template <class T> inline T tmax(const T& a, const T& b) { return a < b ? b : a; }
 
-// Prepare the columns, step factors and bounds of one tick.
-template <class Fmt, int NMAX>
-inline void solver_prepare(const SolverParams<Fmt, NMAX>& P, const Jacobian<Fmt, NMAX>& J,
-                           const typename Fmt::angle_t* q, SolverColumns<Fmt, NMAX>& C, Status& st) {
+// Scaled columns of one task into rows 6t..6t+5: (L w omega_i; w v_i).  weight == nullptr means
+// w = 1 and no multiply (a single task: bit-identical to the unweighted solver).
+template <class Fmt, int NMAX, int ROWS>
+inline void solver_columns(const SolverParams<Fmt, NMAX>& P, const Jacobian<Fmt, NMAX>& J, int t,
+                           const typename Fmt::weight_t* weight, SolverColumns<Fmt, NMAX, ROWS>& C, Status& st) {
   using jsc_t = typename Fmt::jsc_t;
-  using qd_t = typename Fmt::qd_t;
   const int n = J.n;
-  for (int i = 0; i < n; ++i) {
+  typename Fmt::lchar_t L = P.L;
+  if (weight) L = cvt<typename Fmt::lchar_t>(P.L * *weight, st);
+  for (int i = 0; i < n; ++i)
     for (int a = 0; a < 3; ++a) {
-      C.js[i][a] = cvt<jsc_t>(P.L * J.w[i].c[a], st);
-      C.js[i][a + 3] = cvt<jsc_t>(J.v[i].c[a], st);
+      C.js[i][6 * t + a] = cvt<jsc_t>(L * J.w[i].c[a], st);
+      C.js[i][6 * t + a + 3] = weight ? cvt<jsc_t>(*weight * J.v[i].c[a], st) : cvt<jsc_t>(J.v[i].c[a], st);
     }
-    const auto d = (C.js[i][0] * C.js[i][0] + C.js[i][1] * C.js[i][1]) +
-                   ((C.js[i][2] * C.js[i][2] + C.js[i][3] * C.js[i][3]) +
-                    (C.js[i][4] * C.js[i][4] + C.js[i][5] * C.js[i][5]));
+}
+
+// Step factors and the bounds of q' for this tick, from the scaled columns in C.
+template <class Fmt, int NMAX, int ROWS>
+inline void solver_steps(const SolverParams<Fmt, NMAX>& P, const typename Fmt::angle_t* q, int n,
+                         SolverColumns<Fmt, NMAX, ROWS>& C, Status& st) {
+  using qd_t = typename Fmt::qd_t;
+  for (int i = 0; i < n; ++i) {
+    const auto d = dot_exact(C.js[i], C.js[i], C.rows);
     step_factor<Fmt>(d, P.mu[i], C.c[i], C.k[i], st);
     // Bounds: velocity interval, then the position-limit interval clamped into it.
     const qd_t vmax = P.vmax[i];
@@ -131,39 +158,50 @@ inline void solver_prepare(const SolverParams<Fmt, NMAX>& P, const Jacobian<Fmt,
   }
 }
 
-// Solve: qd holds the warm start on entry and q' on return; r receives the final scaled residual.
+// One task (serial chain): columns, step factors and bounds of one tick.
 template <class Fmt, int NMAX>
-inline void solver_run(const SolverParams<Fmt, NMAX>& P, const SolverColumns<Fmt, NMAX>& C, int n,
+inline void solver_prepare(const SolverParams<Fmt, NMAX>& P, const Jacobian<Fmt, NMAX>& J,
+                           const typename Fmt::angle_t* q, SolverColumns<Fmt, NMAX>& C, Status& st) {
+  C.rows = 6;
+  solver_columns(P, J, 0, nullptr, C, st);
+  solver_steps(P, q, J.n, C, st);
+}
+
+// Solve: qd holds the warm start on entry and q' on return; r receives the final scaled residual
+// (C.rows entries).
+template <class Fmt, int NMAX, int ROWS>
+inline void solver_run(const SolverParams<Fmt, NMAX>& P, const SolverColumns<Fmt, NMAX, ROWS>& C, int n,
                        const typename Fmt::tw_t* vs, typename Fmt::qd_t* qd, typename Fmt::tw_t* r, Status& st) {
   using tw_t = typename Fmt::tw_t;
   using qd_t = typename Fmt::qd_t;
   using gk_t = typename Fmt::gk_t;
+  const int rows = C.rows;
   // Warm start, clamped into this tick's box, and the initial residual.  The residual is kept
   // exact (tacc_t: |Js_i q'_i| < 2^9, n <= 64, so |r| < 2^16 and no rounding ever happens), so it
   // never drifts from Vs - Js q' however many sweeps run; only its rounded copy (tw_t) is a
   // multiplier operand.
   using tacc_t = typename Fmt::tacc_t;
   for (int i = 0; i < n; ++i) qd[i] = tmax(C.lo[i], tmin(qd[i], C.hi[i]));
-  tacc_t racc[6];
-  for (int a = 0; a < 6; ++a) {
+  tacc_t racc[ROWS];
+  for (int a = 0; a < rows; ++a) {
     racc[a] = cvt<tacc_t>(vs[a], st);
     for (int i = 0; i < n; ++i) racc[a] = cvt<tacc_t>(racc[a] - C.js[i][a] * qd[i], st);
   }
   for (int sweep = 0; sweep < P.sweeps; ++sweep) {
     for (int i = 0; i < n; ++i) {
       const auto* js = C.js[i];
-      tw_t ro[6];
-      for (int a = 0; a < 6; ++a) ro[a] = cvt<tw_t>(racc[a], st);
-      const auto g = ((js[0] * ro[0] + js[1] * ro[1]) + (js[2] * ro[2] + js[3] * ro[3])) + (js[4] * ro[4] + js[5] * ro[5]);
+      tw_t ro[ROWS];
+      for (int a = 0; a < rows; ++a) ro[a] = cvt<tw_t>(racc[a], st);
+      const auto g = dot_exact(js, ro, rows);
       const gk_t gk = cvt_shr<gk_t>(g, C.k[i], st);
       qd_t qn = cvt<qd_t>(qd[i] + gk * C.c[i], st);
       qn = tmax(C.lo[i], tmin(qn, C.hi[i]));
       const qd_t dq = cvt<qd_t>(qn - qd[i], st);
-      for (int a = 0; a < 6; ++a) racc[a] = cvt<tacc_t>(racc[a] - js[a] * dq, st);
+      for (int a = 0; a < rows; ++a) racc[a] = cvt<tacc_t>(racc[a] - js[a] * dq, st);
       qd[i] = qn;
     }
   }
-  for (int a = 0; a < 6; ++a) r[a] = cvt<tw_t>(racc[a], st);
+  for (int a = 0; a < rows; ++a) r[a] = cvt<tw_t>(racc[a], st);
   for (int i = 0; i < n; ++i) {
     if ((C.lo_pos[i] && !(C.lo[i] < qd[i])) || (C.hi_pos[i] && !(qd[i] < C.hi[i]))) st.raise(ST_LIMIT_ACTIVE);
     if ((!C.lo_pos[i] && !(C.lo[i] < qd[i])) || (!C.hi_pos[i] && !(qd[i] < C.hi[i]))) {

@@ -77,6 +77,8 @@ class Joint:
     axis: np.ndarray
     limits: Limits = field(default_factory=Limits)
     scale: float = 1.0
+    #: parent frame: None = the previous joint (serial chain), "base", or an earlier joint's name
+    parent: str | None = None
 
     @property
     def prismatic(self) -> bool:
@@ -92,6 +94,24 @@ class Joint:
         }
         if self.scale != 1.0:
             d["scale"] = float(self.scale)
+        if self.parent is not None:
+            d["parent"] = self.parent
+        return d
+
+
+@dataclass
+class Tip:
+    """A frame fixed to a joint frame: one controlled frame of a tree of chains."""
+
+    name: str
+    parent: str  # joint name
+    pose: Pose = field(default_factory=Pose)
+    weight: float = 1.0  # row weight of this tip's task in the stacked solve
+
+    def to_dict(self) -> dict:
+        d = {"name": self.name, "parent": self.parent, **self.pose.to_dict()}
+        if self.weight != 1.0:
+            d["weight"] = float(self.weight)
         return d
 
 
@@ -101,10 +121,26 @@ class Chain:
     joints: list[Joint]
     base: Pose = field(default_factory=Pose)
     tool: Pose = field(default_factory=Pose)
+    #: trees of chains (seed section 12): several named tips; empty = serial chain with `tool`
+    tips: list[Tip] = field(default_factory=list)
 
     @property
     def n(self) -> int:
         return len(self.joints)
+
+    @property
+    def is_serial(self) -> bool:
+        return not self.tips and all(j.parent is None for j in self.joints)
+
+    def parent_frames(self) -> list[int]:
+        """Frame index of each joint's parent frame: 0 = base, k = joint k-1's frame (1-based)."""
+        idx = {j.name: i for i, j in enumerate(self.joints)}
+        return [i if j.parent is None else (0 if j.parent == "base" else idx[j.parent] + 1)
+                for i, j in enumerate(self.joints)]
+
+    def tip_list(self) -> list[Tip]:
+        """The tips; a serial chain has one, the tool on the last joint."""
+        return self.tips or [Tip("tool", self.joints[-1].name, self.tool)]
 
     @property
     def lower(self) -> np.ndarray:
@@ -120,13 +156,17 @@ class Chain:
         return np.array([j.scale for j in self.joints])
 
     def to_dict(self) -> dict:
-        return {
+        d = {
             "name": self.name,
             "units": {"length": "m", "angle": "rad"},
             "base": self.base.to_dict(),
-            "tool": self.tool.to_dict(),
-            "joints": [j.to_dict() for j in self.joints],
         }
+        if self.tips:
+            d["tips"] = [t.to_dict() for t in self.tips]
+        else:
+            d["tool"] = self.tool.to_dict()
+        d["joints"] = [j.to_dict() for j in self.joints]
+        return d
 
     def to_json(self) -> str:
         return json.dumps(self.to_dict(), indent=2) + "\n"
@@ -259,7 +299,24 @@ def joint_from_dict(d: Any, where: str) -> Joint:
     scale = _number(_get(d, "scale", where, required=False, default=1.0), f"{where}.scale")
     if scale == 0.0:
         raise InputError(f"{where}.scale", "must be non-zero")
-    return Joint(name, jtype, origin, axis, lim, scale)
+    parent = _get(d, "parent", where, required=False, default=None)
+    if parent is not None and (not isinstance(parent, str) or not parent):
+        raise InputError(f"{where}.parent", "expected a joint name or \"base\"")
+    return Joint(name, jtype, origin, axis, lim, scale, parent)
+
+
+def tip_from_dict(d: Any, where: str) -> Tip:
+    name = _get(d, "name", where)
+    if not isinstance(name, str) or not name:
+        raise InputError(f"{where}.name", "expected a non-empty string")
+    parent = _get(d, "parent", where)
+    if not isinstance(parent, str) or not parent:
+        raise InputError(f"{where}.parent", "expected a joint name")
+    pose = pose_from_dict(d, where)
+    weight = _number(_get(d, "weight", where, required=False, default=1.0), f"{where}.weight")
+    if not 0.0 < weight < 4.0:
+        raise InputError(f"{where}.weight", "must lie in (0, 4)")
+    return Tip(name, parent, pose, weight)
 
 
 def chain_from_dict(d: Any) -> Chain:
@@ -276,6 +333,8 @@ def chain_from_dict(d: Any) -> Chain:
     if units.get("angle", "rad") != "rad":
         raise InputError("units.angle", f"only 'rad' is supported (got {units.get('angle')!r}); use a joint 'scale'")
     base = pose_from_dict(_get(d, "base", "", required=False, default={"xyz": [0, 0, 0], "quat_wxyz": [1, 0, 0, 0]}), "base")
+    if "tips" in d and "tool" in d:
+        raise InputError("tool", "give either 'tool' (serial chain) or 'tips' (tree), not both")
     tool = pose_from_dict(_get(d, "tool", "", required=False, default={"xyz": [0, 0, 0], "quat_wxyz": [1, 0, 0, 0]}), "tool")
     jl = _get(d, "joints", "")
     if not isinstance(jl, list) or not jl:
@@ -285,7 +344,22 @@ def chain_from_dict(d: Any) -> Chain:
     dup = sorted({x for x in names if names.count(x) > 1})
     if dup:
         raise InputError("joints", f"duplicate joint name {dup[0]!r}")
-    return Chain(name, joints, base, tool)
+    for i, j in enumerate(joints):
+        if j.parent is not None and j.parent != "base" and j.parent not in names[:i]:
+            raise InputError(f"joints[{i}].parent", f"{j.parent!r} is not an earlier joint (or \"base\")")
+    tips = []
+    if "tips" in d:
+        tl = d["tips"]
+        if not isinstance(tl, list) or not tl:
+            raise InputError("tips", "expected a non-empty list")
+        tips = [tip_from_dict(t, f"tips[{i}]") for i, t in enumerate(tl)]
+        for i, t in enumerate(tips):
+            if t.parent not in names:
+                raise InputError(f"tips[{i}].parent", f"no joint named {t.parent!r}")
+        tn = [t.name for t in tips]
+        if len(set(tn)) != len(tn):
+            raise InputError("tips", "duplicate tip name")
+    return Chain(name, joints, base, tool, tips)
 
 
 def load(path: str | os.PathLike) -> Chain:
@@ -294,7 +368,7 @@ def load(path: str | os.PathLike) -> Chain:
     if not p.exists():
         from . import robots
 
-        if str(path) in robots.names():
+        if str(path) in robots.names() or str(path) in robots.tree_names():
             return robots.load(str(path))
         raise InputError(str(path), "no such file")
     try:
@@ -380,7 +454,8 @@ def canonical(chain: Chain, eps: float = 1e-15) -> Chain:
         return Pose(clean(p.xyz), _stable_unit(q) if np.any(q) else q)
 
     joints = [Joint(j.name, j.type, pose(j.origin), _stable_unit(a) if np.any(a := clean(j.axis)) else a,
-                    Limits(j.limits.lower, j.limits.upper, j.limits.velocity), j.scale)
+                    Limits(j.limits.lower, j.limits.upper, j.limits.velocity), j.scale, j.parent)
               for j in chain.joints]
-    c = Chain(chain.name, joints, pose(chain.base), pose(chain.tool))
+    tips = [Tip(t.name, t.parent, pose(t.pose), t.weight) for t in chain.tips]
+    c = Chain(chain.name, joints, pose(chain.base), pose(chain.tool), tips)
     return chain_from_dict(json.loads(c.to_json()))

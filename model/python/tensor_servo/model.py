@@ -35,7 +35,8 @@ OVF_MASK = 0xFFFF
 def model_spec(chain: Chain) -> dict:
     """The chain as the C++ model's ChainSpec (a plain dict)."""
     joints = []
-    for j in chain.joints:
+    parents = chain.parent_frames()
+    for i, j in enumerate(chain.joints):
         lim = j.limits
         joints.append({
             "prismatic": j.prismatic,
@@ -47,12 +48,18 @@ def model_spec(chain: Chain) -> dict:
             "lower": float(lim.lower) if lim.bounded else 0.0,
             "upper": float(lim.upper) if lim.bounded else 0.0,
             "velocity": float(lim.velocity) if lim.velocity is not None else 0.0,
+            "parent": -2 if j.parent is None else parents[i] - 1,
         })
-    return {
+    spec = {
         "base_quat": [float(v) for v in chain.base.quat_wxyz], "base_xyz": [float(v) for v in chain.base.xyz],
         "tool_quat": [float(v) for v in chain.tool.quat_wxyz], "tool_xyz": [float(v) for v in chain.tool.xyz],
         "joints": joints,
     }
+    if chain.tips:
+        idx = {j.name: i for i, j in enumerate(chain.joints)}
+        spec["tips"] = [{"parent": idx[t.parent], "quat": [float(v) for v in t.pose.quat_wxyz],
+                         "xyz": [float(v) for v in t.pose.xyz]} for t in chain.tips]
+    return spec
 
 
 def check_config(chain: Chain) -> dict[str, str | None]:
@@ -154,9 +161,10 @@ class Model:
             return self.n + 1
         if frame == "base" and what == "basis":
             return -1
-        if isinstance(frame, (int, np.integer)) and 0 <= int(frame) <= self.n + 1:
+        last = self.n + len(self.chain.tip_list())
+        if isinstance(frame, (int, np.integer)) and 0 <= int(frame) <= last:
             return int(frame)
-        raise InputError(what, f"expected 'base', 'tool' or a frame index 0..{self.n + 1} (got {frame!r})")
+        raise InputError(what, f"expected 'base', 'tool' or a frame index 0..{last} (got {frame!r})")
 
     def quantize_q(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Raw joint values and a per-sample flag 'representable' (no saturation)."""

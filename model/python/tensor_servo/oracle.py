@@ -20,41 +20,46 @@ def _se3(p: Pose) -> pin.SE3:
 
 
 class PinChain:
-    """A Pinocchio model and data for a Chain, with the tool as frame ``tool``."""
+    """A Pinocchio model and data for a Chain (serial or a tree), with its tips as frames (the
+    tool of a serial chain is tip 0)."""
 
     def __init__(self, chain: Chain):
         self.chain = chain
         m = pin.Model()
         m.name = chain.name
-        parent = 0
-        for i, j in enumerate(chain.joints):
+        jid = [0]  # Pinocchio joint id of each frame index 0..n (0: the universe = root)
+        for i, (j, pf) in enumerate(zip(chain.joints, chain.parent_frames())):
             placement = _se3(j.origin)
-            if i == 0:
-                placement = _se3(chain.base) * placement
+            if pf == 0:
+                placement = _se3(chain.base) * placement  # the base frame is not a joint
             axis = np.asarray(j.axis, dtype=float)
             jm = pin.JointModelPrismaticUnaligned(axis) if j.prismatic else pin.JointModelRevoluteUnaligned(axis)
-            parent = m.addJoint(parent, jm, placement, j.name)
-            m.appendBodyToJoint(parent, pin.Inertia.Identity(), pin.SE3.Identity())
-        self.tool_id = m.addFrame(pin.Frame("tool", parent, _se3(chain.tool), pin.FrameType.OP_FRAME))
+            jid.append(m.addJoint(jid[pf], jm, placement, j.name))
+            m.appendBodyToJoint(jid[-1], pin.Inertia.Identity(), pin.SE3.Identity())
+        idx = {j.name: i for i, j in enumerate(chain.joints)}
+        self.tip_ids = [m.addFrame(pin.Frame(t.name, jid[idx[t.parent] + 1], _se3(t.pose), pin.FrameType.OP_FRAME))
+                        for t in chain.tip_list()]
+        self.tool_id = self.tip_ids[0]
         self.model = m
         self.data = m.createData()
         self.scales = chain.scales
 
-    def tool_pose(self, q: np.ndarray) -> np.ndarray:
-        """4x4 pose of the tool in the root frame."""
+    def tool_pose(self, q: np.ndarray, tip: int = 0) -> np.ndarray:
+        """4x4 pose of the tool (or of tip ``tip``) in the root frame."""
         pin.framesForwardKinematics(self.model, self.data, np.asarray(q, float) * self.scales)
-        return self.data.oMf[self.tool_id].homogeneous.copy()
+        return self.data.oMf[self.tip_ids[tip]].homogeneous.copy()
 
     def joint_poses(self, q: np.ndarray) -> np.ndarray:
         """(n, 4, 4): pose of every joint frame after its motion, in the root frame."""
         pin.forwardKinematics(self.model, self.data, np.asarray(q, float) * self.scales)
         return np.array([self.data.oMi[i].homogeneous for i in range(1, self.model.njoints)])
 
-    def jacobian(self, q: np.ndarray, basis: str = "base") -> np.ndarray:
-        """(6, n) Jacobian of the tool origin, rows (omega; v); basis 'base' (root axes) or 'tool'."""
+    def jacobian(self, q: np.ndarray, basis: str = "base", tip: int = 0) -> np.ndarray:
+        """(6, n) Jacobian of the tool (tip) origin, rows (omega; v); basis 'base' (root axes) or
+        'tool' (the tip's own axes)."""
         rf = {"base": pin.ReferenceFrame.LOCAL_WORLD_ALIGNED, "tool": pin.ReferenceFrame.LOCAL}[basis]
         qq = np.asarray(q, float) * self.scales
         pin.computeJointJacobians(self.model, self.data, qq)
         pin.framesForwardKinematics(self.model, self.data, qq)
-        J = np.reshape(pin.getFrameJacobian(self.model, self.data, self.tool_id, rf), (6, -1))
+        J = np.reshape(pin.getFrameJacobian(self.model, self.data, self.tip_ids[tip], rf), (6, -1))
         return np.vstack([J[3:], J[:3]]) * self.scales[None, :]

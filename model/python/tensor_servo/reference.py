@@ -132,19 +132,41 @@ def _check_q(chain: Chain, q: np.ndarray) -> np.ndarray:
     return q
 
 
+def _parents(chain: Chain) -> list[int]:
+    """Parent frame of every frame 1..n+ntips (index 0 unused): serial chain k -> k-1."""
+    tips = chain.tip_list()
+    idx = {j.name: i for i, j in enumerate(chain.joints)}
+    return [0] + chain.parent_frames() + [idx[t.parent] + 1 for t in tips]
+
+
 def fk_frames(chain: Chain, q: np.ndarray) -> np.ndarray:
-    """(n+2, 4, 4): ``^rootT_k`` for k = 0 (base), 1..n (joint frames after motion), n+1 (tool).
+    """(n+1+ntips, 4, 4): ``^rootT_k`` for k = 0 (base), 1..n (joint frames after motion), then the
+    tips (a serial chain has one, the tool: n+1).
 
     The seed's absolute poses ``P_k^(0)`` (eq. 1): ``T_0 = base``,
-    ``T_i = T_{i-1} origin_i M_i(q_i)``, ``T_{n+1} = T_n tool``.
+    ``T_i = T_{parent(i)} origin_i M_i(q_i)`` (serial: parent(i) = i-1), ``T_tip = T_parent tip``.
     """
     q = _check_q(chain, q)
-    T = np.empty((chain.n + 2, 4, 4))
+    tips = chain.tip_list()
+    par = _parents(chain)
+    T = np.empty((chain.n + 1 + len(tips), 4, 4))
     T[0] = chain.base.matrix()
     for i, (joint, qi) in enumerate(zip(chain.joints, q), start=1):
-        T[i] = T[i - 1] @ joint.origin.matrix() @ joint_motion(joint, qi)
-    T[chain.n + 1] = T[chain.n] @ chain.tool.matrix()
+        T[i] = T[par[i]] @ joint.origin.matrix() @ joint_motion(joint, qi)
+    for t, tip in enumerate(tips):
+        T[chain.n + 1 + t] = T[par[chain.n + 1 + t]] @ tip.pose.matrix()
     return T
+
+
+def moving_joints(chain: Chain, k: int) -> set[int]:
+    """Joints (1-based) that move frame k: its ancestors (serial chain: 1..min(k, n))."""
+    par = _parents(chain)
+    out = set()
+    while k >= 1:
+        if k <= chain.n:
+            out.add(k)
+        k = par[k]
+    return out
 
 
 def fk_frames_before(chain: Chain, q: np.ndarray) -> np.ndarray:
@@ -187,7 +209,8 @@ def transport(r: np.ndarray) -> np.ndarray:
 
 
 def frame_index(chain: Chain, k: int | str, *, what: str = "frame") -> int:
-    """Frame index 0..n+1 of ``k``: an int, ``"tool"`` (n+1) or ``"base"`` (0, the base frame)."""
+    """Frame index of ``k``: an int, ``"tool"`` (n+1, the first tip) or ``"base"`` (0)."""
+    last = chain.n + len(chain.tip_list())
     if isinstance(k, str):
         if k == "tool":
             return chain.n + 1
@@ -195,8 +218,8 @@ def frame_index(chain: Chain, k: int | str, *, what: str = "frame") -> int:
             return 0
         raise ValueError(f"{what}: unknown name {k!r} (use 'base', 'tool' or an index)")
     k = int(k)
-    if not 0 <= k <= chain.n + 1:
-        raise ValueError(f"{what}: index {k} outside 0..{chain.n + 1}")
+    if not 0 <= k <= last:
+        raise ValueError(f"{what}: index {k} outside 0..{last}")
     return k
 
 
@@ -222,7 +245,7 @@ def jacobian(chain: Chain, q: np.ndarray, ref: int | str = "tool", basis: int | 
       3. rotate the 6-vector from basis i into the computation basis b with ``^bR_i`` (eq. 19
          [FIX]: the rotation *from basis i*, not H_i^s applied to a basis-j quantity).
 
-    Columns of joints after ``ref`` are zero (eq. 8).  Column i depends only on q_{i+1..ref} when
+    Columns of joints after ``ref`` are zero (eq. 8); in a tree, of joints not on ref's branch.  Column i depends only on q_{i+1..ref} when
     expressed in basis i or basis ref (eq. 20).  ``ref``: ``"tool"`` (= n+1) or a frame index
     0..n+1.  ``basis``: ``"base"`` (root axes), ``"tool"`` or a frame index 0..n+1 (see module doc).
     """
@@ -230,7 +253,7 @@ def jacobian(chain: Chain, q: np.ndarray, ref: int | str = "tool", basis: int | 
     j = frame_index(chain, ref, what="ref")
     Rb = _basis_rotation(chain, T, basis)             # ^rootR_b
     J = np.zeros((6, chain.n))
-    for i in range(1, min(j, chain.n) + 1):           # joints 1..n that precede (or are) ref
+    for i in sorted(moving_joints(chain, j)):         # joints that precede (or are) ref
         W = joint_twist(chain.joints[i - 1])          # W_i, basis i
         H = pose_inv(T[i]) @ T[j]                     # step 1: H_i^ref = ^iT_ref
         V_i = transport(H[:3, 3]) @ W                 # step 2: R_i^ref W_i, basis i, point = origin ref
@@ -259,11 +282,13 @@ def frame_twists(chain: Chain, q: np.ndarray, qd: np.ndarray, basis: str = "base
     if basis not in ("base", "own"):
         raise ValueError(f"basis: unknown {basis!r} (use 'base' or 'own')")
     T = fk_frames(chain, q)
-    V = np.zeros((chain.n + 2, 6))                     # root basis
-    for k in range(1, chain.n + 2):
-        V[k] = transport(T[k][:3, 3] - T[k - 1][:3, 3]) @ V[k - 1]
+    par = _parents(chain)
+    nf = len(T)
+    V = np.zeros((nf, 6))                              # root basis
+    for k in range(1, nf):
+        V[k] = transport(T[k][:3, 3] - T[par[k]][:3, 3]) @ V[par[k]]
         if k <= chain.n:
             V[k] += _rot6(T[k][:3, :3]) @ joint_twist(chain.joints[k - 1]) * qd[k - 1]
     if basis == "own":
-        V = np.array([_rot6(T[k][:3, :3].T) @ V[k] for k in range(chain.n + 2)])
+        V = np.array([_rot6(T[k][:3, :3].T) @ V[k] for k in range(nf)])
     return V

@@ -27,7 +27,7 @@ def default_params(chain: Chain, dt: float) -> dict:
     return {
         "L": 0.5, "kp": 0.3 / dt, "ko": 0.3 / dt, "dt": dt, "klim": 0.5 / dt, "sweeps": 2,
         "mu": [1.0] * chain.n, "mode": "A", "feedforward": True, "controlled": -1, "setpoint_frame": -1,
-        "vlimits": True,
+        "vlimits": True, "weights": None,
     }
 
 
@@ -64,8 +64,13 @@ class Servo:
             p["mu"] = [float(p["mu"])] * chain.n
         if p["controlled"] == "tool":
             p["controlled"] = -1
+        ctl = p["controlled"]
+        p["controlled"] = [int(c) for c in ctl] if isinstance(ctl, (list, tuple)) else [int(ctl)]
+        if p["weights"] is None:
+            p["weights"] = [1.0] * len(p["controlled"])
         if p["setpoint_frame"] is None:
             p["setpoint_frame"] = -1
+        self.ntasks = len(p["controlled"])
         self.chain, self.config, self.params = chain, config, p
         try:
             self._s = _model.Servo(config, model_spec(chain), p)
@@ -74,15 +79,27 @@ class Servo:
         self.n = chain.n
 
     def tick(self, q: np.ndarray, U: np.ndarray, Ud: np.ndarray | None = None, qd_warm: np.ndarray | None = None) -> TickOut:
-        uq, up = pose_to_quat_pos(U)
-        Ud = np.zeros(6) if Ud is None else np.asarray(Ud, dtype=float)
+        """One tick.  One task: U (4,4), Ud (6,); T tasks (trees): U (T,4,4), Ud (T,6), and
+        ep/eo come back (T,3) instead of (3,)."""
+        U = np.asarray(U, dtype=float)
+        single = U.ndim == 2
+        Us = U[None] if single else U
+        if Us.shape[0] != self.ntasks:
+            raise InputError("U", f"{self.ntasks} setpoint(s) expected, got {Us.shape[0]}")
+        qp = [pose_to_quat_pos(u) for u in Us]
+        uq = np.array([a for a, _ in qp]); up = np.array([b for _, b in qp])
+        Ud = np.zeros((self.ntasks, 6)) if Ud is None else np.asarray(Ud, dtype=float).reshape(self.ntasks, 6)
         w = np.zeros(self.n) if qd_warm is None else np.asarray(qd_warm, dtype=float)
         try:
-            d = self._s.tick(np.asarray(q, dtype=float), uq, up, Ud[:3], Ud[3:], w)
+            d = self._s.tick(np.asarray(q, dtype=float), uq, up, np.ascontiguousarray(Ud[:, :3]),
+                             np.ascontiguousarray(Ud[:, 3:]), w)
         except ValueError as e:
             raise InputError("tick", str(e)) from None
         raw = {k[:-4]: v for k, v in d.items() if k.endswith("_raw")} or None
-        return TickOut(d["qd"], d["q_next"], d["ep"], d["eo"], d["r"], int(d["flags"]), raw)
+        ep, eo = (d["ep"][0], d["eo"][0]) if single else (d["ep"], d["eo"])
+        if raw and single:
+            raw["ep"], raw["eo"] = raw["ep"][0], raw["eo"][0]
+        return TickOut(d["qd"], d["q_next"], ep, eo, d["r"], int(d["flags"]), raw)
 
     def ik(self, q0: np.ndarray, targets: np.ndarray, max_ticks: int = 500, tol_pos: float = 1e-6,
            tol_rot: float = 1e-5) -> dict:

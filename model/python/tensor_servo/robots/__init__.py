@@ -21,14 +21,21 @@ HERE = Path(__file__).resolve().parent
 
 
 def names() -> list[str]:
-    """Names of the embedded examples, sorted."""
+    """Names of the embedded serial-chain examples, sorted."""
     return sorted(p.stem for p in HERE.glob("*.json"))
+
+
+def tree_names() -> list[str]:
+    """Names of the embedded trees of chains (several tips; seed section 12), in ``trees/``."""
+    return sorted(p.stem for p in (HERE / "trees").glob("*.json"))
 
 
 def path(name: str) -> Path:
     """The JSON file of an embedded example; InputError for an unknown name."""
+    if name in tree_names():
+        return HERE / "trees" / f"{name}.json"
     if name not in names():
-        raise InputError(str(name), f"no such file or embedded example (examples: {', '.join(names())})")
+        raise InputError(str(name), f"no such file or embedded example (examples: {', '.join(names() + tree_names())})")
     return HERE / f"{name}.json"
 
 
