@@ -23,10 +23,12 @@ from .model import CONFIGS, model_spec
 
 
 def default_params(chain: Chain, dt: float) -> dict:
-    """Safe defaults (docs/solver.md): gains 0.3/dt, limit-approach gain 0.5/dt, L = 0.5 m."""
+    """Safe defaults (docs/solver.md, "Safe defaults"): gains 0.3/dt, limit-approach gain 0.5/dt,
+    L = 0.5 m, 10 sweeps with relaxation mu = 1.5 (measured on PUMA 560: worst-case settling 43
+    ticks instead of > 600 with 2 sweeps / mu = 1; stable with actuator lags up to 10 ticks)."""
     return {
-        "L": 0.5, "kp": 0.3 / dt, "ko": 0.3 / dt, "dt": dt, "klim": 0.5 / dt, "sweeps": 2,
-        "mu": [1.0] * chain.n, "mode": "A", "feedforward": True, "controlled": -1, "setpoint_frame": -1,
+        "L": 0.5, "kp": 0.3 / dt, "ko": 0.3 / dt, "dt": dt, "klim": 0.5 / dt, "sweeps": 10,
+        "mu": [1.5] * chain.n, "mode": "A", "feedforward": True, "controlled": -1, "setpoint_frame": -1,
         "vlimits": True, "weights": None,
     }
 
