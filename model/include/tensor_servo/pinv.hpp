@@ -26,8 +26,11 @@
 //                         (Lawson & Hanson 1974 ch. 23, Stark & Parker 1995 "BVLS"): from a feasible
 //                         point, step towards the re-solved free-set solution as far as the box
 //                         allows and fix the coordinate that blocks.  The objective never increases
-//                         in phase 2, which is what guarantees termination (block exclusion alone can
-//                         cycle).  Ends at a KKT point, or with status IterationCap.
+//                         in phase 2 (block exclusion and re-admission alone can cycle); the method
+//                         is finite in exact arithmetic for full column rank, and degenerate cases
+//                         (rounding-level multipliers) are guarded by a noise floor, by blocking a
+//                         coordinate that bounces straight back, and by the iteration cap.
+//                         Ends at a KKT point, or with status IterationCap (output still feasible).
 //   Free-set subproblems are solved for the minimum-norm solution by a complete orthogonal
 //   decomposition (Eigen::CompleteOrthogonalDecomposition) with a relative rank tolerance:
 //   a pivot |R_kk| <= rank_tol * |R_11| of the column-pivoted QR is treated as zero (|R_11| is the
@@ -38,7 +41,8 @@
 // dls_solve()   -- damped least squares q' = J^T (J J^T + lambda^2 I)^-1 V in the weighted metric,
 //                  i.e. min |b - A x|^2 + lambda^2 |x|^2 = the least-squares problem of
 //                  [A; lambda I] x = [b; 0], so the same box and active set apply unchanged.
-//                  Damping::Adaptive (Nakamura & Hanafusa 1986, Maciejewski & Klein 1988):
+//                  Damping::Adaptive (in the style of Nakamura & Hanafusa 1986, Maciejewski &
+//                  Klein 1988; `lambda` is then lambda_max):
 //                  lambda^2 = lambda_max^2 (1 - (sigma_min / eps)^2) when sigma_min < eps, else 0,
 //                  sigma_min = the min(6, n)-th singular value of A.
 //
@@ -66,6 +70,7 @@ struct PinvOptions {
   Exclusion exclusion = Exclusion::ActiveSet;
   double rank_tol = 1e-10;    // relative rank tolerance of the COD (see the header comment)
   double readmit_tol = 1e-9;  // re-admit when the inward descent rate exceeds readmit_tol |A_i| |r|
+                              // (and the rounding floor 1e-12 |A_i| (|b| + |A x|))
   int max_iter = 0;           // cap on least-squares solves; 0: 20 + 10 n
 };
 
@@ -226,24 +231,28 @@ inline PinvResult box_lsq(const Eigen::MatrixXd& A, const Eigen::VectorXd& b, co
     // (step 0): it is then blocked until the objective decreases again.
     std::vector<bool> blocked(n, false);
     double f_blocked = 0;  // objective when the blocks were set
-    auto progress = [&]() {
+    const double fb = 0.5 * b.squaredNorm();
+    auto progress = [&]() {  // a decrease above the rounding level of the objective
       const double f = 0.5 * (b - A * x).squaredNorm();
-      if (f < f_blocked * (1 - 1e-12)) std::fill(blocked.begin(), blocked.end(), false);
+      if (f < f_blocked - 1e-13 * (f_blocked + fb)) std::fill(blocked.begin(), blocked.end(), false);
     };
     bool capped = false;
     while (!capped) {
       // Multipliers: g = dF/dx = -A^T (b - A x).  At a lower bound moving inward (up) helps when
-      // g_i < 0; at an upper bound when g_i > 0.  Re-admit the largest such rate per unit column.
-      const Eigen::VectorXd r = b - A * x;
+      // g_i < 0; at an upper bound when g_i > 0.  Re-admit the largest such rate per unit column,
+      // if it exceeds readmit_tol |A_i| |r| and the rounding level of g, 1e-12 |A_i| (|b| + |A x|)
+      // (at an exact fit every multiplier is rounding noise).
+      const Eigen::VectorXd Ax = A * x;
+      const Eigen::VectorXd r = b - Ax;
       const Eigen::VectorXd g = -(A.transpose() * r);
-      const double rn = r.norm();
+      const double floor = std::max(opt.readmit_tol * r.stableNorm(), 1e-12 * (b.stableNorm() + Ax.stableNorm()));
       int best = -1;
       double best_rate = 0;
       for (int i = 0; i < n; ++i) {
         if (st[i] == BoundState::Free || lower[i] == upper[i] || blocked[i]) continue;
         const double inward = st[i] == BoundState::Lower ? -g[i] : g[i];
         const double cn = A.col(i).stableNorm();  // stable: tiny columns must not underflow to 0
-        if (cn == 0 || !(inward > opt.readmit_tol * cn * rn)) continue;
+        if (cn == 0 || !(inward > cn * floor)) continue;
         if (inward / cn > best_rate) { best_rate = inward / cn; best = i; }
       }
       if (best < 0) break;  // KKT point
