@@ -24,7 +24,7 @@ PKG      := model/python/tensor_servo
 STAMP_APT  := $(BUILD)/.apt.stamp
 STAMP_VENV := $(VENV)/.stamp
 
-.PHONY: help setup build test test-cpp test-py demo bench golden lint clean distclean
+.PHONY: help setup build test test-cpp test-py demo bench golden lint clean distclean hls-csim hls-lint hls-tables
 
 help:
 	@sed -n '2,7p' Makefile | sed 's/^# //'
@@ -102,8 +102,17 @@ bench: setup
 golden: setup
 	$(VENV)/bin/tservo golden -o tb/golden
 
-lint: setup
-	@echo "lint: nothing yet"
+lint: setup hls-lint
+
+# ---- HLS (C-simulation with g++; Vitis users: hls/run_hls.tcl, docs/hls.md) -----------------------
+hls-csim: build
+	$(PY) hls/tb/csim.py
+
+hls-lint: setup
+	$(PY) scripts/hls_lint.py
+
+hls-tables: setup
+	$(PY) hls/gen_tables.py
 
 clean:
 	rm -rf $(BUILD) $(PKG)/_model.*.so

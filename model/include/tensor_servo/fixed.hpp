@@ -18,12 +18,36 @@
 //
 // Exact intermediates are held in int64_t; formats whose width would exceed 62 bits are rejected
 // at compile time, so no intermediate can wrap silently.
+//
+// Number families.  The algorithm headers never name fx directly; they see a family of numbers
+// through a configuration Fmt (formats.hpp) and this small interface, which fx implements here and
+// hls/ts_ap_fixed.h implements for ap_fixed:
+//   storage types (Fmt::angle_t, ..., and Fmt::num<W, I, FLAG>, the family's type of a format)
+//       static W, I, F, FLAG, RAW_MAX, RAW_MIN;  T::from_raw(int64_t);  T{} is zero
+//   every value (storage types and the wider results of exact + - *)
+//       raw_of(x)                   the two's-complement raw value, as int64_t
+//       num_traits<X>::W, I, F      its format (the primary template reads the storage members)
+//       cvt<Dst>, wrap<Dst>, cvt_shr<Dst>, ilog2, scale_pow2<K>, < > ==, exact + - * and unary -
+// The constant tables (TrigTable, RecipTable, RotvecTable) are read through static accessors, so
+// a configuration can specialise them with constant arrays (hls/ts_tables_<config>.h); the
+// model's primary templates build them once from std::sin etc.  The double overloads below accept
+// exactly double, so a family with an implicit conversion to double (ap_fixed) can never fall
+// back to them silently.
 #pragma once
 #include <cmath>
 #include <cstdint>
 #include <type_traits>
 #ifdef TS_TRACE  // debugging aid: print every saturation (type, flag, value) to stderr
 #include <cstdio>
+#endif
+
+// HLS directives written next to the loops they shape: `#pragma HLS ...` under Vitis HLS synthesis
+// (__SYNTHESIS__), nothing for every other compiler (docs/hls.md).
+#if defined(__SYNTHESIS__)
+#define TS_PRAGMA_(x) _Pragma(#x)
+#define TS_HLS(...) TS_PRAGMA_(HLS __VA_ARGS__)
+#else
+#define TS_HLS(...)
 #endif
 
 namespace ts {
@@ -96,9 +120,22 @@ struct fx {
   }
 };
 
+// Format of a value.  The primary template reads the storage-type members (fx, hls' apfx);
+// hls/ts_ap_fixed.h specialises it for the intermediate ap_fixed results.
+template <class T>
+struct num_traits {
+  static constexpr int W = T::W;
+  static constexpr int I = T::I;
+  static constexpr int F = T::F;
+};
+
 template <class T> struct is_fx : std::false_type {};
 template <int W, int I, uint32_t FL> struct is_fx<fx<W, I, FL>> : std::true_type {};
 template <class T> constexpr bool is_fx_v = is_fx<std::decay_t<T>>::value;
+
+// The raw value of a number (storage or intermediate).
+template <int W, int I, uint32_t L>
+constexpr int64_t raw_of(const fx<W, I, L>& x) { return x.raw; }
 
 namespace detail {
 constexpr int cmax(int a, int b) { return a > b ? a : b; }
@@ -169,24 +206,34 @@ inline Dst wrap(fx<W, I, L> x) {
 
 // cvt with a run-time power of two: Dst = x * 2^-k rounded (AP_RND) and saturated.  Used where the
 // algorithm normalises by a leading-one position found at run time (the solver's reciprocal).
-template <class Dst, int W, int I, uint32_t L>
-inline Dst cvt_shr(fx<W, I, L> x, int k, Status& st) {
-  const int s = (W - I) + k - Dst::F;  // right shift of the raw value
+namespace detail {
+// The integer core of cvt_shr (shared by every number family): raw value x with fraction Fs,
+// times 2^-k, rounded (AP_RND) to fraction Fd and saturated to [rmin, rmax].
+inline int64_t shr_round_sat(int64_t x, int Fs, int k, int Fd, int64_t rmin, int64_t rmax, bool& sat) {
+  const int s = Fs + k - Fd;  // right shift of the raw value
   int64_t r;
   if (s > 0) {
-    r = s >= 62 ? 0 : detail::round_raw(x.raw, s, 0);  // |x.raw| <= 2^61: beyond, |value| <= 1/2 LSB -> 0
+    r = s >= 62 ? 0 : round_raw(x, s, 0);  // |x| <= 2^61: beyond, |value| <= 1/2 LSB -> 0
   } else {
     const int l = -s;
     const int64_t lim = int64_t(1) << 62;
-    if (l >= 62 || x.raw >= (lim >> l) || x.raw < -(lim >> l)) r = x.raw > 0 ? Dst::RAW_MAX + 1 : (x.raw < 0 ? Dst::RAW_MIN - 1 : 0);
-    else r = detail::shl(x.raw, l);
+    if (l >= 62 || x >= (lim >> l) || x < -(lim >> l)) r = x > 0 ? rmax + 1 : (x < 0 ? rmin - 1 : 0);
+    else r = shl(x, l);
   }
-  if (r > Dst::RAW_MAX) { st.raise(Dst::FLAG); return Dst::from_raw(Dst::RAW_MAX); }
-  if (r < Dst::RAW_MIN) { st.raise(Dst::FLAG); return Dst::from_raw(Dst::RAW_MIN); }
+  sat = r > rmax || r < rmin;
+  return r > rmax ? rmax : (r < rmin ? rmin : r);
+}
+}  // namespace detail
+
+template <class Dst, int W, int I, uint32_t L>
+inline Dst cvt_shr(fx<W, I, L> x, int k, Status& st) {
+  bool sat;
+  const int64_t r = detail::shr_round_sat(x.raw, W - I, k, Dst::F, Dst::RAW_MIN, Dst::RAW_MAX, sat);
+  if (sat) st.raise(Dst::FLAG);
   return Dst::from_raw(r);
 }
-template <class Dst>
-inline double cvt_shr(double x, int k, Status&) { return std::ldexp(x, -k); }
+template <class Dst, class D, std::enable_if_t<std::is_same_v<D, double>, int> = 0>
+inline double cvt_shr(D x, int k, Status&) { return std::ldexp(x, -k); }
 
 // Position of the leading one of a positive value: returns k with 2^k <= x < 2^(k+1); x <= 0
 // returns INT_MIN/2 (callers treat it as "zero").
@@ -195,7 +242,8 @@ inline int ilog2(fx<W, I, L> x) {
   if (x.raw <= 0) return -(1 << 20);
   return (63 - __builtin_clzll(static_cast<unsigned long long>(x.raw))) - (W - I);
 }
-inline int ilog2(double x) {
+template <class D, std::enable_if_t<std::is_same_v<D, double>, int> = 0>
+inline int ilog2(D x) {
   if (!(x > 0)) return -(1 << 20);
   int e;
   std::frexp(x, &e);
@@ -210,10 +258,10 @@ inline T max_of() {
 }
 
 // ---- double instantiation: the identity ---------------------------------------------------------
-template <class Dst>
-inline double cvt(double x, Status&) { return x; }
-template <class Dst>
-inline double wrap(double x) { return x - std::floor(x + 0.5); }  // [-1/2, 1/2) turns
+template <class Dst, class D, std::enable_if_t<std::is_same_v<D, double>, int> = 0>
+inline double cvt(D x, Status&) { return x; }
+template <class Dst, class D, std::enable_if_t<std::is_same_v<D, double>, int> = 0>
+inline double wrap(D x) { return x - std::floor(x + 0.5); }  // [-1/2, 1/2) turns
 
 template <class T> inline double to_double(const T& v) { return v.to_double(); }
 inline double to_double(double v) { return v; }

@@ -22,6 +22,9 @@
 //
 // No drift: the pose is recomputed from q every tick, so rounding errors never accumulate over
 // time; their bound grows only with the number of joints (docs/numerics.md).
+//
+// Loops run to the compile-time bounds NMAX / TMAX and skip the entries beyond the configured n
+// (the form HLS needs; hls/ instantiates these functions on ap_fixed).
 #pragma once
 #include "chain.hpp"
 
@@ -70,7 +73,9 @@ inline void forward_kinematics(const ChainQ<Fmt, NMAX, TMAX>& ch, const typename
   f.ntips = ch.ntips;
   f.Q[0] = ch.qb;
   f.p[0] = vec_cvt<pos_t>(ch.pb, st);  // exact widening
-  for (int i = 1; i <= n; ++i) {
+  for (int i = 1; i <= NMAX; ++i) {
+    // Serial dependence through the parent frame: one joint after the other (docs/hls.md).
+    if (i > n) continue;
     const JointQ<Fmt>& jq = ch.j[i - 1];
     const int pf = ch.parent[i - 1];  // serial chain: i - 1
     const Quat<quat_t> QF = qmul<quat_t>(f.Q[pf], jq.qo, st);
@@ -86,7 +91,8 @@ inline void forward_kinematics(const ChainQ<Fmt, NMAX, TMAX>& ch, const typename
       for (int a = 0; a < 3; ++a) f.p[i].c[a] = cvt<pos_t>(pF.c[a] + d * f.z[i].c[a], st);
     }
   }
-  for (int t = 0; t < ch.ntips; ++t) {
+  for (int t = 0; t < TMAX; ++t) {
+    if (t >= ch.ntips) continue;
     const int pf = ch.tip_parent[t];  // serial chain: the tool on frame n
     f.Q[n + 1 + t] = qmul<quat_t>(f.Q[pf], ch.qt[t], st);
     const Vec3<pos_t> off = rotate<pos_t, len_tmp_t>(f.Q[pf], ch.pt[t], st);
@@ -95,10 +101,12 @@ inline void forward_kinematics(const ChainQ<Fmt, NMAX, TMAX>& ch, const typename
 }
 
 // Mark the joints that move frame f (its ancestors): on_path[j] for joint j (0-based).
+// Every step goes to a lower frame index, so at most NMAX + 1 steps reach the base.
 template <class Fmt, int NMAX, int TMAX>
 inline void joints_moving(const ChainQ<Fmt, NMAX, TMAX>& ch, int f, bool* on_path) {
-  for (int j = 0; j < ch.n; ++j) on_path[j] = false;
-  while (f >= 1) {
+  for (int j = 0; j < NMAX; ++j) on_path[j] = false;
+  for (int step = 0; step <= NMAX; ++step) {
+    if (f < 1) continue;
     if (f <= ch.n) on_path[f - 1] = true;
     f = ch.parent_frame(f);
   }
@@ -132,7 +140,11 @@ inline void jacobian(const ChainQ<Fmt, NMAX, TMAX>& ch, const Frames<Fmt, NMAX, 
   J.n = n;
   bool moves[NMAX];
   joints_moving(ch, ref, moves);
-  for (int i = 1; i <= n; ++i) {
+  for (int i = 1; i <= NMAX; ++i) {
+    // Independent columns: pipelined, II 4 shares the ~40 multipliers of a column by four
+    // (latency ~ 20 cycles + 4 per column; docs/hls.md).
+    TS_HLS(PIPELINE II=4)
+    if (i > n) continue;
     Vec3<jw_t>& w = J.w[i - 1];
     Vec3<jv_t>& v = J.v[i - 1];
     if (!moves[i - 1]) {

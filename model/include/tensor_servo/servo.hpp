@@ -29,6 +29,8 @@ namespace ts {
 
 enum ErrorMode : int { ERR_A = 0, ERR_B = 1 };
 
+// f(j 2^-T) and its forward differences, read through f_at / df_at (a configuration may
+// specialise the table with constant arrays, as TrigTable).
 template <class Fmt>
 struct RotvecTable {
   static constexpr int N = 1 << Fmt::ROTVEC_TABLE_BITS;
@@ -45,6 +47,8 @@ struct RotvecTable {
     static const RotvecTable t;
     return t;
   }
+  static typename Fmt::rvf_t f_at(int j) { return get().f[j]; }
+  static typename Fmt::rvf_t df_at(int j) { return get().df[j]; }
 };
 
 // Rotation vector (rad) of a unit quaternion, in rot_t.
@@ -61,13 +65,13 @@ inline Vec3<typename Fmt::rot_t> rotvec(Quat<typename Fmt::quat_t> q, Status& st
     using rvf_t = typename Fmt::rvf_t;
     constexpr int T = Fmt::ROTVEC_TABLE_BITS;
     constexpr int FB = quat_t::F - T;  // fraction bits of the interpolation weight
-    const int64_t w = q.c[0].raw;
+    const int64_t w = raw_of(q.c[0]);
     int idx = static_cast<int>(w >> FB);
     int64_t frac = w & ((int64_t(1) << FB) - 1);
     if (idx > (1 << T)) { idx = 1 << T; frac = 0; }  // w > 1 + 2^-T cannot come from a unit quaternion
-    const auto& tab = RotvecTable<Fmt>::get();
-    const auto wgt = fx<FB + 1, 1>::from_raw(frac);
-    const rvf_t f = cvt<rvf_t>(tab.f[idx] + tab.df[idx] * wgt, st);
+    using tab = RotvecTable<Fmt>;
+    const auto wgt = Fmt::template num<FB + 1, 1>::from_raw(frac);
+    const rvf_t f = cvt<rvf_t>(tab::f_at(idx) + tab::df_at(idx) * wgt, st);
     for (int a = 0; a < 3; ++a) r.c[a] = cvt<rot_t>(pow2<1>(f * q.c[a + 1]), st);
   }
   return r;
@@ -160,8 +164,8 @@ inline void task_error(const ChainQ<Fmt, NMAX, TMAX>& ch, const ServoParams<Fmt,
   if (k >= 1) {
     bool moves_k[NMAX];
     joints_moving(ch, k, moves_k);
-    for (int i = 0; i < ch.n; ++i)
-      if (moves_k[i])
+    for (int i = 0; i < NMAX; ++i)
+      if (i < ch.n && moves_k[i])
         for (int a = 0; a < 3; ++a) { J.w[i].c[a] = typename Fmt::jw_t{}; J.v[i].c[a] = typename Fmt::jv_t{}; }
   }
 }
@@ -180,27 +184,25 @@ inline void servo_tick(const ChainQ<Fmt, NMAX, TMAX>& ch, const ServoParams<Fmt,
   SolverColumns<Fmt, NMAX, 6 * TMAX> C;
   C.rows = 6 * T;
   tw_t vs[6 * TMAX];
-  for (int t = 0; t < T; ++t) {
+  for (int t = 0; t < TMAX; ++t) {
+    if (t >= T) continue;
     const int ctl = P.controlled[t] < 0 ? n + 1 + t : P.controlled[t];
     Vec3<vel_t> V_w, V_v;
     task_error(ch, P, R.frames, ctl, U[t], R.ep[t], R.eo[t], V_w, V_v, R.J[t], st);
     // Scaled (and, for several tasks, weighted) target and columns of this task.
     const typename Fmt::weight_t* w = T > 1 ? &P.weight[t] : nullptr;
-    typename Fmt::lchar_t L = P.solver.L;
-    if (w) L = cvt<typename Fmt::lchar_t>(P.solver.L * *w, st);
-    for (int a = 0; a < 3; ++a) {
-      vs[6 * t + a] = cvt<tw_t>(L * V_w.c[a], st);
-      vs[6 * t + a + 3] = w ? cvt<tw_t>(*w * V_v.c[a], st) : cvt<tw_t>(V_v.c[a], st);
-    }
+    solver_target(P.solver, V_w, V_v, t, w, vs, st);
     solver_columns(P.solver, R.J[t], t, w, C, st);
   }
   solver_steps(P.solver, q, n, C, st);
-  for (int i = 0; i < n; ++i) R.qd[i] = qd_warm[i];
+  for (int i = 0; i < NMAX; ++i)
+    if (i < n) R.qd[i] = qd_warm[i];
   solver_run(P.solver, C, n, vs, R.qd, R.r, st);
 
   // Virtual-mode integration, clamped to the position limits.
   using angle_t = typename Fmt::angle_t;
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < NMAX; ++i) {
+    if (i >= n) continue;
     angle_t qn = cvt<angle_t>(q[i] + R.qd[i] * P.dt, st);
     if (P.solver.limited[i]) qn = tmax(P.solver.lo[i], tmin(qn, P.solver.hi[i]));
     R.q_next[i] = qn;

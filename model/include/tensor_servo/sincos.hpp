@@ -18,7 +18,6 @@
 // no divider.  u = 0 gives exactly (0, 1).  For FmtDouble the same entry point is std::sin/cos.
 #pragma once
 #include <cmath>
-#include <vector>
 
 #include "fixed.hpp"
 
@@ -26,13 +25,18 @@ namespace ts {
 
 constexpr double kPi = 3.14159265358979323846;
 
-// The quarter-wave table of a configuration: 2^T entries of (sin, cos).
+// The quarter-wave table of a configuration: 2^T entries of (sin, cos), and the two constants of
+// the residual rotation.  The model builds it once from std::sin/cos; the algorithm reads it only
+// through the static accessors, which a configuration may specialise with constant arrays
+// (hls/ts_tables_<config>.h, generated from this table).
 template <class Fmt>
 struct TrigTable {
   using tab_t = typename Fmt::tab_t;
   static constexpr int N = 1 << Fmt::TRIG_TABLE_BITS;
   tab_t s[N];
   tab_t c[N];
+  typename Fmt::twopi_t twopi_value;  // 2 pi
+  typename Fmt::sixth_t sixth_value;  // 1/6
   TrigTable() {
     Status st;
     for (int k = 0; k < N; ++k) {
@@ -40,11 +44,18 @@ struct TrigTable {
       s[k] = tab_t::from_double(std::sin(a), st);
       c[k] = tab_t::from_double(std::cos(a), st);
     }
+    Status const_st;  // the two constants fit their formats (checked in the unit tests)
+    twopi_value = Fmt::twopi_t::from_double(2.0 * kPi, const_st);
+    sixth_value = Fmt::sixth_t::from_double(1.0 / 6.0, const_st);
   }
   static const TrigTable& get() {
     static const TrigTable t;
     return t;
   }
+  static tab_t sin_at(int k) { return get().s[k]; }
+  static tab_t cos_at(int k) { return get().c[k]; }
+  static typename Fmt::twopi_t two_pi() { return get().twopi_value; }
+  static typename Fmt::sixth_t sixth() { return get().sixth_value; }
 };
 
 // sin and cos of 2 pi u (u in turns).  Outputs in Fmt::quat_t.
@@ -68,16 +79,16 @@ inline void sincos_turns(typename Fmt::turn_t u, typename Fmt::quat_t& sin_out,
     constexpr int R = WU - 2 - T;
     static_assert(R >= 1, "turn format too narrow for the table");
     static_assert(turn_t::I == 0, "turn_t must be fx<W, 0>");
-    const uint64_t bits = static_cast<uint64_t>(u.raw) & ((uint64_t(1) << WU) - 1);
+    const uint64_t bits = static_cast<uint64_t>(raw_of(u)) & ((uint64_t(1) << WU) - 1);
     const int quadrant = static_cast<int>(bits >> (WU - 2));
     const int index = static_cast<int>((bits >> R) & ((1u << T) - 1));
     const int64_t residual = static_cast<int64_t>(bits & ((uint64_t(1) << R) - 1));
     // residual * 2^-WU turns, as an exact fx with R magnitude bits and a sign bit.
-    using res_t = fx<R + 1, R + 1 - WU>;
+    using res_t = typename Fmt::template num<R + 1, R + 1 - WU>;
     const auto delta = res_t::from_raw(residual);
-    Status const_st;  // the two constants fit their formats (checked in the unit tests)
-    static const twopi_t two_pi = twopi_t::from_double(2.0 * kPi, const_st);
-    static const sixth_t sixth = sixth_t::from_double(1.0 / 6.0, const_st);
+    using tab = TrigTable<Fmt>;
+    const twopi_t two_pi = tab::two_pi();
+    const sixth_t sixth = tab::sixth();
 
     const delta_t d = cvt<delta_t>(delta * two_pi, st);
     const dsq_t d2 = cvt<dsq_t>(d * d, st);
@@ -85,9 +96,8 @@ inline void sincos_turns(typename Fmt::turn_t u, typename Fmt::quat_t& sin_out,
     const dsq_t e = cvt<dsq_t>(d2 * sixth, st);
     const delta_t de = cvt<delta_t>(d * e, st);
     const delta_t sd = cvt<delta_t>(d - de, st);
-    const auto& tab = TrigTable<Fmt>::get();
-    const auto S = tab.s[index];
-    const auto C = tab.c[index];
+    const auto S = tab::sin_at(index);
+    const auto C = tab::cos_at(index);
     using acc_t = typename Fmt::trig_acc_t;
     const acc_t Sh = cvt<acc_t>(S * h, st);
     const acc_t Ch = cvt<acc_t>(C * h, st);

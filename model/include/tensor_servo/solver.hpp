@@ -28,7 +28,8 @@
 //     for s in 1..sweeps, for i in 1..n:
 //         g   = <Js_i, round(r)> (exact);  gk = g 2^-k_i (rounded);  q_new = clamp(q'_i + gk c_i)
 //         dq  = q_new - q'_i;  r -= Js_i dq (exact: r never drifts);  q'_i = q_new
-// Twist order (omega; v) everywhere.
+// Twist order (omega; v) everywhere.  Loops run to compile-time bounds (NMAX joints, ROWS rows,
+// Fmt::SWEEPS_MAX sweeps) and skip the entries beyond the configured ones (the form HLS needs).
 #pragma once
 #include "kinematics.hpp"
 
@@ -57,7 +58,8 @@ struct SolverColumns {
   bool lo_pos[NMAX], hi_pos[NMAX];         // the bound comes from a position limit
 };
 
-// The reciprocal table: y0[j] = 1 / (1 + (j + 1/2) 2^-T), rounded to recip_t.
+// The reciprocal table: y0[j] = 1 / (1 + (j + 1/2) 2^-T), rounded to recip_t.  Read through at()
+// (a configuration may specialise the table with a constant array, as TrigTable).
 template <class Fmt>
 struct RecipTable {
   static constexpr int N = 1 << Fmt::RECIP_TABLE_BITS;
@@ -70,21 +72,26 @@ struct RecipTable {
     static const RecipTable t;
     return t;
   }
+  static typename Fmt::recip_t at(int j) { return get().y[j]; }
 };
 
-// Exact sum of m products a[i] b[i] (m <= 32): the accumulator has 5 more integer bits than one
-// product, so no rounding and no overflow can occur (the RTL uses the same width).
-template <class A, class B>
+// Exact sum of m <= M products a[i] b[i] (M <= 32): the accumulator has 5 more integer bits than
+// one product, so no rounding and no overflow can occur (the RTL uses the same width).
+template <class Fmt, int M, class A, class B>
 inline auto dot_exact(const A* a, const B* b, int m) {
+  static_assert(M <= 32, "dot_exact: accumulator sized for at most 32 products");
   if constexpr (std::is_same_v<A, double>) {
     double acc = 0;
-    for (int i = 0; i < m; ++i) acc += a[i] * b[i];
+    for (int i = 0; i < M; ++i)
+      if (i < m) acc += a[i] * b[i];
     return acc;
   } else {
-    using P = decltype(a[0] * b[0]);
-    using Acc = fx<P::W + 5, P::I + 5>;
-    Acc acc{};
-    for (int i = 0; i < m; ++i) acc = Acc::from_raw(acc.raw + (a[i] * b[i]).raw * (int64_t(1) << (Acc::F - P::F)));
+    using P = num_traits<decltype(a[0] * b[0])>;
+    using Acc = typename Fmt::template num<P::W + 5, P::I + 5>;
+    Acc acc = Acc::from_raw(0);
+    // The sum has the accumulator's fraction bits and |sum| < 2^(P::I + 3): wrap never wraps.
+    for (int i = 0; i < M; ++i)
+      if (i < m) acc = wrap<Acc>(acc + a[i] * b[i]);
     return acc;
   }
 }
@@ -103,13 +110,15 @@ inline void step_factor(const D& d, typename Fmt::mu_t mu, typename Fmt::step_t&
     using recip_t = typename Fmt::recip_t;
     constexpr int T = Fmt::RECIP_TABLE_BITS;
     // m = d 2^-k truncated to mant_t (keep the leading bits; never rounds up to 2).
-    const int s = (D::W - D::I) + k - mant_t::F;
-    const int64_t mr = s >= 0 ? (d.raw >> s) : detail::shl(d.raw, -s);
+    const int s = num_traits<D>::F + k - mant_t::F;
+    const int64_t dr = raw_of(d);
+    const int64_t mr = s >= 0 ? (dr >> s) : detail::shl(dr, -s);
     const mant_t m = mant_t::from_raw(mr);
     const int idx = static_cast<int>((mr >> (mant_t::F - T)) & ((1 << T) - 1));
-    const recip_t y0 = RecipTable<Fmt>::get().y[idx];
-    using e_t = fx<recip_t::W, recip_t::I - T, ST_OVF_SOLVER>;  // |1 - m y0| < 2^-(T+1)
-    const e_t e = cvt<e_t>(fx<2, 2>::from_raw(1) - m * y0, st);
+    const recip_t y0 = RecipTable<Fmt>::at(idx);
+    using e_t = typename Fmt::template num<recip_t::W, recip_t::I - T, ST_OVF_SOLVER>;  // |1 - m y0| < 2^-(T+1)
+    const auto one = Fmt::template num<2, 2>::from_raw(1);
+    const e_t e = cvt<e_t>(one - m * y0, st);
     const recip_t y = cvt<recip_t>(y0 + y0 * e, st);
     c = cvt<step_t>(mu * y, st);
   }
@@ -127,11 +136,28 @@ inline void solver_columns(const SolverParams<Fmt, NMAX>& P, const Jacobian<Fmt,
   const int n = J.n;
   typename Fmt::lchar_t L = P.L;
   if (weight) L = cvt<typename Fmt::lchar_t>(P.L * *weight, st);
-  for (int i = 0; i < n; ++i)
+  for (int i = 0; i < NMAX; ++i) {
+    TS_HLS(PIPELINE II=1)  // 3 (6 weighted) products per column; latency ~ 5 cycles + NMAX
+    if (i >= n) continue;
     for (int a = 0; a < 3; ++a) {
       C.js[i][6 * t + a] = cvt<jsc_t>(L * J.w[i].c[a], st);
       C.js[i][6 * t + a + 3] = weight ? cvt<jsc_t>(*weight * J.v[i].c[a], st) : cvt<jsc_t>(J.v[i].c[a], st);
     }
+  }
+}
+
+// Scaled target of one task into rows 6t..6t+5: (L w V_omega; w V_v), as the columns above.
+template <class Fmt, int NMAX>
+inline void solver_target(const SolverParams<Fmt, NMAX>& P, const Vec3<typename Fmt::vel_t>& V_w,
+                          const Vec3<typename Fmt::vel_t>& V_v, int t, const typename Fmt::weight_t* weight,
+                          typename Fmt::tw_t* vs, Status& st) {
+  using tw_t = typename Fmt::tw_t;
+  typename Fmt::lchar_t L = P.L;
+  if (weight) L = cvt<typename Fmt::lchar_t>(P.L * *weight, st);
+  for (int a = 0; a < 3; ++a) {
+    vs[6 * t + a] = cvt<tw_t>(L * V_w.c[a], st);
+    vs[6 * t + a + 3] = weight ? cvt<tw_t>(*weight * V_v.c[a], st) : cvt<tw_t>(V_v.c[a], st);
+  }
 }
 
 // Step factors and the bounds of q' for this tick, from the scaled columns in C.
@@ -139,8 +165,10 @@ template <class Fmt, int NMAX, int ROWS>
 inline void solver_steps(const SolverParams<Fmt, NMAX>& P, const typename Fmt::angle_t* q, int n,
                          SolverColumns<Fmt, NMAX, ROWS>& C, Status& st) {
   using qd_t = typename Fmt::qd_t;
-  for (int i = 0; i < n; ++i) {
-    const auto d = dot_exact(C.js[i], C.js[i], C.rows);
+  for (int i = 0; i < NMAX; ++i) {
+    TS_HLS(PIPELINE II=2)  // |Js_i|^2, reciprocal and bounds per column; latency ~ 25 cycles + 2 NMAX
+    if (i >= n) continue;
+    const auto d = dot_exact<Fmt, ROWS>(C.js[i], C.js[i], C.rows);
     step_factor<Fmt>(d, P.mu[i], C.c[i], C.k[i], st);
     // Bounds: velocity interval, then the position-limit interval clamped into it.
     const qd_t vmax = P.vmax[i];
@@ -181,28 +209,40 @@ inline void solver_run(const SolverParams<Fmt, NMAX>& P, const SolverColumns<Fmt
   // never drifts from Vs - Js q' however many sweeps run; only its rounded copy (tw_t) is a
   // multiplier operand.
   using tacc_t = typename Fmt::tacc_t;
-  for (int i = 0; i < n; ++i) qd[i] = tmax(C.lo[i], tmin(qd[i], C.hi[i]));
+  for (int i = 0; i < NMAX; ++i)
+    if (i < n) qd[i] = tmax(C.lo[i], tmin(qd[i], C.hi[i]));
   tacc_t racc[ROWS];
-  for (int a = 0; a < rows; ++a) {
+  TS_HLS(ARRAY_PARTITION variable=racc type=complete)  // all rows updated in parallel
+  for (int a = 0; a < ROWS; ++a) {
+    if (a >= rows) continue;
     racc[a] = cvt<tacc_t>(vs[a], st);
-    for (int i = 0; i < n; ++i) racc[a] = cvt<tacc_t>(racc[a] - C.js[i][a] * qd[i], st);
+    for (int i = 0; i < NMAX; ++i)
+      if (i < n) racc[a] = cvt<tacc_t>(racc[a] - C.js[i][a] * qd[i], st);
   }
-  for (int sweep = 0; sweep < P.sweeps; ++sweep) {
-    for (int i = 0; i < n; ++i) {
+  for (int sweep = 0; sweep < Fmt::SWEEPS_MAX; ++sweep) {
+    if (sweep >= P.sweeps) break;
+    for (int i = 0; i < NMAX; ++i) {
+      // Gauss-Seidel: each coordinate step needs the residual of the previous one, so the
+      // steps are sequential (latency ~ 20 cycles each); the row loops inside are unrolled.
+      if (i >= n) continue;
       const auto* js = C.js[i];
       tw_t ro[ROWS];
-      for (int a = 0; a < rows; ++a) ro[a] = cvt<tw_t>(racc[a], st);
-      const auto g = dot_exact(js, ro, rows);
+      for (int a = 0; a < ROWS; ++a)
+        if (a < rows) ro[a] = cvt<tw_t>(racc[a], st);
+      const auto g = dot_exact<Fmt, ROWS>(js, ro, rows);
       const gk_t gk = cvt_shr<gk_t>(g, C.k[i], st);
       qd_t qn = cvt<qd_t>(qd[i] + gk * C.c[i], st);
       qn = tmax(C.lo[i], tmin(qn, C.hi[i]));
       const qd_t dq = cvt<qd_t>(qn - qd[i], st);
-      for (int a = 0; a < rows; ++a) racc[a] = cvt<tacc_t>(racc[a] - js[a] * dq, st);
+      for (int a = 0; a < ROWS; ++a)
+        if (a < rows) racc[a] = cvt<tacc_t>(racc[a] - js[a] * dq, st);
       qd[i] = qn;
     }
   }
-  for (int a = 0; a < rows; ++a) r[a] = cvt<tw_t>(racc[a], st);
-  for (int i = 0; i < n; ++i) {
+  for (int a = 0; a < ROWS; ++a)
+    if (a < rows) r[a] = cvt<tw_t>(racc[a], st);
+  for (int i = 0; i < NMAX; ++i) {
+    if (i >= n) continue;
     if ((C.lo_pos[i] && !(C.lo[i] < qd[i])) || (C.hi_pos[i] && !(qd[i] < C.hi[i]))) st.raise(ST_LIMIT_ACTIVE);
     if ((!C.lo_pos[i] && !(C.lo[i] < qd[i])) || (!C.hi_pos[i] && !(qd[i] < C.hi[i]))) {
       if (P.vmax[i] < max_of<qd_t>()) st.raise(ST_VLIMIT_ACTIVE);
