@@ -57,7 +57,8 @@ constexpr int SE_MODE = 3;         // 0: error choice A, 1: B
 constexpr int SE_FEEDFORWARD = 4;  // 1: feed the setpoint twist forward, 0: error only
 constexpr int SE_SETPOINT_FRAME = 5;  // -1: setpoint in the root frame; k: relative to frame k (0..n)
 constexpr int SE_CONTROLLED = 6;   // -1: the tool; k: joint frame k (1..n)
-constexpr int SERVO_WORDS = 8;     // 7 reserved
+constexpr int SE_WARM_LEAK = 7;    // warm-start leak shift s (0: none), 0..20
+constexpr int SERVO_WORDS = 8;
 
 // ---- stream packets (one per tick; fixed length for a build's NMAX) -------------------------
 // kinematics   in : q[NMAX] (angle_t; entries j >= n ignored)

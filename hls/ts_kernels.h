@@ -125,8 +125,10 @@ bool unpack_servo(const int32_t* cfg, int n, ServoParams<Fmt, NMAX, 1>& P) {
   P.ko = cfg_word<typename Fmt::gain_t>(cfg[SE_KO], ok);
   P.dt = cfg_word<typename Fmt::dt_t>(cfg[SE_DT], ok);
   const int mode = cfg[SE_MODE], ff = cfg[SE_FEEDFORWARD];
-  const int spf = cfg[SE_SETPOINT_FRAME], ctl = cfg[SE_CONTROLLED];
+  const int spf = cfg[SE_SETPOINT_FRAME], ctl = cfg[SE_CONTROLLED], leak = cfg[SE_WARM_LEAK];
   if (mode != ERR_A && mode != ERR_B) ok = false;
+  if (leak < 0 || leak > 20) ok = false;
+  P.warm_leak = ok ? leak : 0;
   if (ff != 0 && ff != 1) ok = false;
   if (spf < -1 || spf > n) ok = false;
   if (!(ctl == -1 || (ctl >= 1 && ctl <= n))) ok = false;

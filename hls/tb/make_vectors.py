@@ -35,6 +35,7 @@ VARIANTS = [
     {"feedforward": False, "sweeps": 3},
     {"mode": "B", "sweeps": 1, "setpoint_frame": 0, "vlimits": False},
     {"setpoint_frame": 2, "sweeps": 4, "mu": 1.5},
+    {"warm_leak": 5, "sweeps": 3},
 ]
 
 
@@ -58,7 +59,7 @@ def chain_file(name: str, cfg: str) -> str:
     p = default_params(ch, 1e-3)
     p.update(controlled=[-1], weights=[1.0])
     s = _model.Servo(cfg, model_spec(ch), p).params_raw()
-    for k in ("L", "klim", "sweeps", "kp", "ko", "dt", "mode", "feedforward", "setpoint_frame"):
+    for k in ("L", "klim", "sweeps", "kp", "ko", "dt", "mode", "feedforward", "setpoint_frame", "warm_leak"):
         out.append(line(k, [int(s[k])]))
     for k in ("mu", "limited", "lo", "hi", "vmax"):
         out.append(line(k, s[k]))
@@ -96,7 +97,7 @@ def servo_file(name: str, cfg: str, ticks: int, seed: int) -> str:
         s = _model.Servo(cfg, model_spec(ch), p)
         pr = s.params_raw()
         pre = f"v{vi}_"
-        for k in ("L", "klim", "sweeps", "kp", "ko", "dt", "mode", "feedforward", "setpoint_frame"):
+        for k in ("L", "klim", "sweeps", "kp", "ko", "dt", "mode", "feedforward", "setpoint_frame", "warm_leak"):
             out.append(line(pre + k, [int(pr[k])]))
         for k in ("mu", "limited", "lo", "hi", "vmax"):
             out.append(line(pre + k, pr[k]))

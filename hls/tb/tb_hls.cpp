@@ -138,7 +138,7 @@ ChainRaw chain_from(const KV& kv, const std::string& pre) {
 
 struct ParamsRaw {
   int64_t L, klim, kp, ko, dt;
-  int sweeps, mode, ff, spf, ctl = -1;
+  int sweeps, mode, ff, spf, leak = 0, ctl = -1;
   std::vector<int64_t> mu, lo, hi, vmax;
   std::vector<int> limited;
 };
@@ -150,6 +150,7 @@ ParamsRaw params_from(const KV& kv, const std::string& pre, int n) {
   p.sweeps = static_cast<int>(at(kv, pre + "sweeps")[0]); p.mode = static_cast<int>(at(kv, pre + "mode")[0]);
   p.ff = static_cast<int>(at(kv, pre + "feedforward")[0]);
   p.spf = static_cast<int>(at(kv, pre + "setpoint_frame")[0]);
+  p.leak = static_cast<int>(at(kv, pre + "warm_leak")[0]);
   for (int j = 0; j < n; ++j) {
     p.mu.push_back(at(kv, pre + "mu")[j]); p.lo.push_back(at(kv, pre + "lo")[j]);
     p.hi.push_back(at(kv, pre + "hi")[j]); p.vmax.push_back(at(kv, pre + "vmax")[j]);
@@ -188,7 +189,7 @@ Words solver_words_of(const ParamsRaw& p, int n) {
 Words servo_words_of(const ParamsRaw& p) {
   Words w(SERVO_WORDS, 0);
   w[SE_KP] = int32_t(p.kp); w[SE_KO] = int32_t(p.ko); w[SE_DT] = int32_t(p.dt); w[SE_MODE] = p.mode;
-  w[SE_FEEDFORWARD] = p.ff; w[SE_SETPOINT_FRAME] = p.spf; w[SE_CONTROLLED] = p.ctl;
+  w[SE_FEEDFORWARD] = p.ff; w[SE_SETPOINT_FRAME] = p.spf; w[SE_CONTROLLED] = p.ctl; w[SE_WARM_LEAK] = p.leak;
   return w;
 }
 
@@ -237,6 +238,7 @@ struct Model {
     }
     P.kp = M::gain_t::from_raw(p.kp); P.ko = M::gain_t::from_raw(p.ko); P.dt = M::dt_t::from_raw(p.dt);
     P.mode = p.mode; P.feedforward = p.ff != 0; P.setpoint_frame = p.spf; P.ntasks = 1; P.controlled[0] = p.ctl;
+    P.warm_leak = p.leak;
   }
 
   // Expected output packets, in the layout of ts_config.h.
@@ -763,6 +765,7 @@ void check_refusals(const std::string& dir) {
   add("sweeps = SWEEPS_MAX + 1", 1, SV_SWEEPS, HlsDefault::SWEEPS_MAX + 1);
   add("limit flag 2", 1, SV_JOINT0 + SJ_LIMITED, 2);
   add("mode 2", 2, SE_MODE, 2);
+  add("warm leak 21", 2, SE_WARM_LEAK, 21);
   add("setpoint frame n + 1", 2, SE_SETPOINT_FRAME, n + 1);
   add("controlled frame 0", 2, SE_CONTROLLED, 0);
   int bad = 0;

@@ -86,6 +86,8 @@ struct Servo final : ServoBase {
     if (mode != "A" && mode != "B") throw std::invalid_argument("mode: 'A' or 'B'");
     P.mode = mode == "A" ? ERR_A : ERR_B;
     P.feedforward = pd["feedforward"].cast<bool>();
+    P.warm_leak = pd.contains("warm_leak") ? pd["warm_leak"].cast<int>() : 0;
+    if (P.warm_leak < 0 || P.warm_leak > 20) throw std::invalid_argument("warm_leak: a shift 0..20");
     // Tasks: "controlled" is a list of frame indices (-1: tip t); "weights" one per task.
     const auto ctl = pd["controlled"].cast<std::vector<int>>();
     const auto wts = pd["weights"].cast<std::vector<double>>();
@@ -225,7 +227,7 @@ struct Servo final : ServoBase {
     return py::dict("L"_a = raw_of(P.solver.L), "klim"_a = raw_of(P.solver.klim), "sweeps"_a = P.solver.sweeps,
                     "mu"_a = mu, "lo"_a = lo, "hi"_a = hi, "vmax"_a = vmax, "limited"_a = lim,
                     "kp"_a = raw_of(P.kp), "ko"_a = raw_of(P.ko), "dt"_a = raw_of(P.dt), "mode"_a = P.mode,
-                    "feedforward"_a = P.feedforward, "ntasks"_a = P.ntasks,
+                    "feedforward"_a = P.feedforward, "ntasks"_a = P.ntasks, "warm_leak"_a = P.warm_leak,
                     "setpoint_frame"_a = P.setpoint_frame);
   }
 };

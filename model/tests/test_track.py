@@ -201,3 +201,25 @@ def test_bench_tracking_table_meets_the_lsb_goal_on_one_path():
     dist = float(cells[6])
     assert 0 < dist <= 4 * lsb("default", "perr_t")
     assert cells[7].endswith("ok") and cells[8] == "0x0"
+
+
+def test_core_warm_leak_equals_the_loop_leak():
+    """The servo's own warm-start leak (ServoParams.warm_leak, what the core and the HLS kernel
+    implement) is bit for bit the leak track.warm_start applies outside the tick."""
+    from tensor_servo.servo import Servo
+
+    ch = robots.load("panda")
+    rng = np.random.default_rng(5)
+    q = ch.random_q(rng)
+    U = reference.fk_frames(ch, ch.random_q(rng))[-1]
+    inner = Servo(ch, "default", dt=1e-3, warm_leak=5)
+    outer = Servo(ch, "default", dt=1e-3)
+    W, I = formats("default")["qd_t"]
+    lsb = 2.0 ** -(W - I)
+    w = np.zeros(ch.n)
+    for _ in range(20):
+        a = inner.tick(q, U, None, w)
+        b = outer.tick(q, U, None, warm_start(w, 5, lsb))
+        assert np.array_equal(a.raw["qd"], b.raw["qd"])
+        w = a.qd
+    assert np.any(w != 0)

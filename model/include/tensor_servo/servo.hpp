@@ -88,6 +88,7 @@ struct ServoParams {
   int controlled[TMAX];             // frame of each task; -1: tip t (the tool for task 0)
   typename Fmt::weight_t weight[TMAX];  // row weight of each task (used when ntasks > 1)
   int setpoint_frame = -1;          // -1: U in the root frame; k: U relative to frame k
+  int warm_leak = 0;                // warm start q'_warm - (q'_warm >> s); 0: none (docs/solver.md)
   ServoParams() { for (int t = 0; t < TMAX; ++t) controlled[t] = -1; }
 };
 
@@ -170,6 +171,16 @@ inline void task_error(const ChainQ<Fmt, NMAX, TMAX>& ch, const ServoParams<Fmt,
   }
 }
 
+// The warm start's leak: x - (x >> s) on the raw value (arithmetic shift, i.e. floor), one shifter
+// and one subtractor; the double configuration uses x (1 - 2^-s).  s = 0: no leak.  Without it a
+// joint rate in the null space of a redundant chain persists as self-motion (docs/solver.md).
+template <class T>
+inline T warm_leak(const T& x, int s) {
+  if (s <= 0) return x;
+  if constexpr (std::is_same_v<T, double>) return x - std::ldexp(x, -s);
+  else return T::from_raw(raw_of(x) - (raw_of(x) >> s));
+}
+
 // One servo tick.  U: one setpoint per task; qd_warm: the previous tick's q' (warm start).
 template <class Fmt, int NMAX, int TMAX>
 inline void servo_tick(const ChainQ<Fmt, NMAX, TMAX>& ch, const ServoParams<Fmt, NMAX, TMAX>& P,
@@ -196,7 +207,7 @@ inline void servo_tick(const ChainQ<Fmt, NMAX, TMAX>& ch, const ServoParams<Fmt,
   }
   solver_steps(P.solver, q, n, C, st);
   for (int i = 0; i < NMAX; ++i)
-    if (i < n) R.qd[i] = qd_warm[i];
+    if (i < n) R.qd[i] = warm_leak(qd_warm[i], P.warm_leak);
   solver_run(P.solver, C, n, vs, R.qd, R.r, st);
 
   // Virtual-mode integration, clamped to the position limits.

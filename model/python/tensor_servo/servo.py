@@ -30,6 +30,7 @@ def default_params(chain: Chain, dt: float) -> dict:
         "L": 0.5, "kp": 0.3 / dt, "ko": 0.3 / dt, "dt": dt, "klim": 0.5 / dt, "sweeps": 10,
         "mu": [1.5] * chain.n, "mode": "A", "feedforward": True, "controlled": -1, "setpoint_frame": -1,
         "vlimits": True, "weights": None,
+        "warm_leak": 0,  # leak of the warm start inside the tick (track.py applies its own by default)
     }
 
 
