@@ -13,7 +13,7 @@
 #include <string>
 
 #include "common.hpp"
-#include "tensor_servo/kinematics.hpp"
+#include "tensor_servo/core_config.hpp"
 
 namespace py = pybind11;
 using namespace pybind11::literals;
@@ -40,7 +40,7 @@ struct Model final : ModelBase {
   ChainQ<Fmt, NMAX> ch;
 
   explicit Model(const ChainSpec& spec) {
-    const ConfigResult r = quantize<Fmt, NMAX>(spec, ch);
+    const ConfigResult r = configure_chain<Fmt, NMAX>(spec, ch);
     if (!r.ok()) throw std::invalid_argument(r.field + ": " + r.message);
   }
   int n() const override { return ch.n; }

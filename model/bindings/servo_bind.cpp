@@ -11,7 +11,7 @@
 // weights (list, one per task),
 // setpoint_frame (-1 = root, k = frame k of the chain).
 #include "common.hpp"
-#include "tensor_servo/servo.hpp"
+#include "tensor_servo/core_config.hpp"
 
 namespace py = pybind11;
 using namespace pybind11::literals;
@@ -50,7 +50,7 @@ struct Servo final : ServoBase {
   ServoParams<Fmt, NMAX> P;  // TMAX = 4 tasks (trees of chains)
 
   Servo(const ChainSpec& spec, const py::dict& pd) {
-    const ConfigResult r = quantize<Fmt, NMAX>(spec, ch);
+    const ConfigResult r = configure_chain<Fmt, NMAX>(spec, ch);
     if (!r.ok()) throw std::invalid_argument(r.field + ": " + r.message);
     Status st;
     auto& S = P.solver;

@@ -2,7 +2,7 @@
 #include <random>
 
 #include "check.hpp"
-#include "tensor_servo/kinematics.hpp"
+#include "tensor_servo/core_config.hpp"
 
 using namespace ts;
 
@@ -146,7 +146,7 @@ TEST_CASE("fk: identity chain is exact") {
 }
 
 TEST_CASE("config: bad chains are refused with the right code and field") {
-  auto code = [](const ChainSpec& c) { ChainQ<FmtCompact, 8> q; return quantize(c, q); };
+  auto code = [](const ChainSpec& c) { ChainQ<FmtCompact, 8> q; return configure_chain(c, q); };
   ChainSpec ok; ok.joints.resize(2);
   for (auto& j : ok.joints) { j.lower = -1; j.upper = 1; }
   CHECK(code(ok).ok());

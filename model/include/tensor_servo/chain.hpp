@@ -138,6 +138,26 @@ inline double chain_reach(const ChainSpec& c) {
   return r;
 }
 
+// k = s/(4 pi) from the quantised scale: one multiply by the constant 1/(4 pi) (the core computes
+// it at commit the same way); saturation of kturn_t means the scale is out of range.
+template <class Fmt>
+inline typename Fmt::kturn_t derive_kturn(typename Fmt::scale_t s, Status& st) {
+  if constexpr (Fmt::is_float) { (void)st; return s / (4.0 * kPi); }
+  else {
+    Status c;
+    static const typename Fmt::inv4pi_t inv = Fmt::inv4pi_t::from_double(1.0 / (4.0 * kPi), c);
+    return cvt<typename Fmt::kturn_t>(s * inv, st);
+  }
+}
+
+// A storage value from a raw register word (saturating: a word outside the format flags nothing
+// here; the register map documents the widths).
+template <class T>
+inline T of_raw_storage(int64_t r) {
+  if constexpr (std::is_same_v<T, double>) return static_cast<double>(r);
+  else return T::from_raw(r > T::RAW_MAX ? T::RAW_MAX : (r < T::RAW_MIN ? T::RAW_MIN : r));
+}
+
 template <class Fmt, int NMAX, int TMAX>
 inline ConfigResult quantize(const ChainSpec& c, ChainQ<Fmt, NMAX, TMAX>& out) {
   using quat_t = typename Fmt::quat_t;
@@ -200,15 +220,7 @@ inline ConfigResult quantize(const ChainSpec& c, ChainQ<Fmt, NMAX, TMAX>& out) {
     }
     smax = std::max(smax, std::fabs(js.scale));
   }
-  const double reach = chain_reach(c);
-  const double base_r = detail::norm3(c.base_xyz);
-  if (base_r + reach >= detail::fmt_max<typename Fmt::pos_t>() * margin)
-    return fail(CFG_REACH, -1, "joints", "chain reach " + std::to_string(base_r + reach) +
-                                         " m exceeds the position format");
-  if (reach >= detail::fmt_max<typename Fmt::lever_t>() * margin)
-    return fail(CFG_REACH, -1, "joints", "chain reach " + std::to_string(reach) + " m exceeds the lever-arm format");
-  if (smax * reach >= detail::fmt_max<typename Fmt::jv_t>() * margin)
-    return fail(CFG_REACH, -1, "joints", "scale x reach exceeds the Jacobian format");
+  (void)smax;  // the reach is checked on the quantised chain (core_config.hpp check_chain)
 
   Status st;
   out.n = n;
@@ -234,7 +246,9 @@ inline ConfigResult quantize(const ChainSpec& c, ChainQ<Fmt, NMAX, TMAX>& out) {
     detail::quant_array<len_t, 3>(js.origin_xyz, q.po.c, st);
     detail::quant_array<quat_t, 3>(js.axis, q.axis.c, st);
     q.s = from_double<typename Fmt::scale_t>(js.scale, st);
-    q.k = from_double<typename Fmt::kturn_t>(js.prismatic ? 0.0 : js.scale / (4.0 * kPi), st);
+    Status ks;
+    q.k = js.prismatic ? typename Fmt::kturn_t{} : derive_kturn<Fmt>(q.s, ks);
+    if (ks.overflow()) return fail(CFG_SCALE, i, "joints[" + std::to_string(i) + "].scale", "scale outside the range of the turn constant");
   }
   if (st.overflow()) return fail(CFG_OFFSET, -1, "chain", "a constant did not fit its format");
   return ConfigResult{};

@@ -29,6 +29,7 @@ struct FmtDouble {
   static constexpr int SWEEPS_MAX = 1 << 30;
   using angle_t = double;
   using kturn_t = double;
+  using inv4pi_t = double;
   using turn_t = double;
   using scale_t = double;
   using tab_t = double;
@@ -82,6 +83,7 @@ struct FmtDefaultT {
   static constexpr int SWEEPS_MAX = 1 << 30;
   using angle_t = N<32, 4, ST_OVF_ANGLE>;      // joint value q, joint units, |q| < 8
   using kturn_t = N<30, -1, ST_OVF_CONST>;     // s/(4 pi): joint unit -> half-angle turns, |s| < pi
+  using inv4pi_t = N<32, -2>;                  // 1/(4 pi): k = cvt<kturn_t>(s * 1/(4 pi))
   using turn_t = N<32, 0>;                     // half angle in turns, modulo one turn (wraps)
   using scale_t = N<27, 3, ST_OVF_CONST>;      // s: joint unit -> rad or m, |s| < 4
   using tab_t = N<27, 2, ST_OVF_TRIG>;         // quarter-wave table entries, [0, 1]
@@ -134,6 +136,7 @@ struct FmtCompactT {
   static constexpr int SWEEPS_MAX = 1 << 30;
   using angle_t = N<18, 4, ST_OVF_ANGLE>;
   using kturn_t = N<18, -2, ST_OVF_CONST>;      // |s| < pi/2
+  using inv4pi_t = N<18, -2>;
   using turn_t = N<26, 0>;
   using scale_t = N<18, 3, ST_OVF_CONST>;
   using tab_t = N<18, 2, ST_OVF_TRIG>;

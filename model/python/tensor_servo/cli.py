@@ -14,7 +14,7 @@ import sys
 from .errors import InputError
 
 # Modules that add commands (each has register(subparsers)).
-COMMAND_MODULES = ["cli_chain", "cli_kin", "cli_track"]
+COMMAND_MODULES = ["cli_chain", "cli_kin", "cli_track", "cli_ik"]
 
 
 class _Parser(argparse.ArgumentParser):
