@@ -176,8 +176,8 @@ struct Servo final : ServoBase {
     return d;
   }
 
-  // Virtual-mode IK: run ticks towards each target (U' = 0) from q0 until the model's own errors
-  // are within tolerance (checked before each move) or max_ticks.
+  // Virtual-mode IK: run ticks towards each target (U' = 0) from q0, each solved from a cold start,
+  // until the model's own errors are within tolerance (checked before each move) or max_ticks.
   py::dict ik(const f64arr& q0, const f64arr& tq, const f64arr& tp, int max_ticks, double tol_pos,
               double tol_rot) const override {
     const int n = ch.n;
@@ -205,7 +205,9 @@ struct Servo final : ServoBase {
         }
         if (ep <= tol_pos && eo <= tol_rot) { ok = true; break; }
         if (t == max_ticks) break;
-        for (int i = 0; i < n; ++i) { qq[i] = R->q_next[i]; warm[i] = R->qd[i]; }
+        // Cold start every tick (docs/ik.md: a warm start keeps null-space rates of redundant
+        // chains alive and slows convergence in virtual IK).
+        for (int i = 0; i < n; ++i) { qq[i] = R->q_next[i]; warm[i] = qd_t{}; }
       }
       for (int i = 0; i < n; ++i) qo.mutable_at(s, i) = to_double(qq[i]);
       ticks.mutable_at(s) = t;
