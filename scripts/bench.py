@@ -6,6 +6,10 @@
 Sections (each prints a table and, unless --no-write, rewrites its section of docs/benchmarks.md):
   kin   FK of every frame + tool Jacobian per call: the C++ model (double, default, compact) vs
         Pinocchio C++ (computeFrameJacobian, LOCAL_WORLD_ALIGNED), same chains, same joint values
+  ik    IK success and time on 1000 reachable targets per chain, near and random seeds: our servo
+        (double, fixed) vs roboticstoolbox ik_LM, Pinocchio CLIK and ikpy (bench_ik.py; ~15 min)
+  track steady tracking error of a circle and a figure-eight at 1 and 10 kHz, fixed vs float
+        (bench_tracking.py)
 """
 from __future__ import annotations
 
@@ -106,7 +110,20 @@ def bench_kin(seconds: float) -> str:
     return table + "\n\n" + "\n".join(verdict)
 
 
-SECTIONS = {"kin": bench_kin}
+def bench_ik_section(seconds: float) -> str:
+    from tensor_servo.bench_ik import bench_ik
+
+    table, verdict = bench_ik(n_targets=int(os.environ.get("TS_BENCH_IK_TARGETS", "1000")))
+    return table + "\n\n" + verdict
+
+
+def bench_track_section(seconds: float) -> str:
+    from tensor_servo.bench_tracking import bench_tracking
+
+    return bench_tracking()
+
+
+SECTIONS = {"kin": bench_kin, "ik": bench_ik_section, "track": bench_track_section}
 
 
 def replace_section(text: str, name: str, body: str) -> str:
