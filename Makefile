@@ -24,7 +24,7 @@ PKG      := model/python/tensor_servo
 STAMP_APT  := $(BUILD)/.apt.stamp
 STAMP_VENV := $(VENV)/.stamp
 
-.PHONY: help setup build test test-cpp test-py demo bench golden lint clean distclean hls-csim hls-lint hls-tables
+.PHONY: help setup build test test-cpp test-py demo bench golden lint clean distclean hls-csim hls-lint hls-tables regs regs-check regs-html
 
 help:
 	@sed -n '2,7p' Makefile | sed 's/^# //'
@@ -103,6 +103,16 @@ golden: setup
 	$(VENV)/bin/tservo golden -o tb/golden
 
 lint: setup hls-lint
+
+# ---- register map (rtl/ts_servo_regs.rdl -> Verilog, C header, Python, docs) -------------------------
+regs: setup
+	$(PY) scripts/gen_regs.py
+
+regs-check: setup
+	$(PY) scripts/gen_regs.py --check
+
+regs-html: setup
+	$(PY) scripts/gen_regs.py --html $(BUILD)/regs-html
 
 # ---- HLS (C-simulation with g++; Vitis users: hls/run_hls.tcl, docs/hls.md) -----------------------
 hls-csim: build

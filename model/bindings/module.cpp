@@ -21,6 +21,7 @@ using namespace ts;
 using namespace tsbind;
 
 void bind_servo(py::module_& m);  // servo_bind.cpp
+void bind_pinv(py::module_& m);   // pinv_bind.cpp
 
 namespace {
 
@@ -327,6 +328,7 @@ PYBIND11_MODULE(_model, m) {
   m.attr("NMAX") = NMAX;
   m.attr("CONFIGS") = py::make_tuple("double", "default", "compact");
   bind_servo(m);
+  bind_pinv(m);
   py::class_<ModelBase>(m, "Model")
       .def(py::init(&make_model), py::arg("config"), py::arg("spec"))
       .def_property_readonly("n", &ModelBase::n)

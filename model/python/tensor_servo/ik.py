@@ -51,7 +51,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import reference
+from . import _model, reference
 from .chain import Chain, Limits, matrix_to_quat
 from .errors import InputError
 
@@ -330,79 +330,21 @@ def _minnorm(A: np.ndarray, b: np.ndarray, rank_tol: float = 1e-10) -> np.ndarra
     return Vt[keep].T @ ((U[:, keep].T @ b) / s[keep])
 
 
-def box_lsq(A: np.ndarray, b: np.ndarray, lower: np.ndarray, upper: np.ndarray, max_iter: int | None = None) -> np.ndarray:
-    """min 1/2 |b - A x|^2 s.t. lower <= x <= upper: the seed's coordinate exclusion (phase 1: solve
-    over the remaining coordinates, fix every one that leaves the box at the bound it violated,
-    re-solve) followed by the primal active-set method with re-admission (phase 2, BVLS); free
-    subproblems are solved for the minimum-norm solution (``pinv.hpp``, Exclusion::ActiveSet)."""
-    n = A.shape[1]
-    x = np.zeros(n)
-    st = np.zeros(n, dtype=np.int8)          # 0 free, -1 at lower, +1 at upper
-    pt = lower == upper
-    st[pt] = -1
-    x[pt] = lower[pt]
-    slack = 1e-12 * (1.0 + np.where(np.isfinite(lower), np.abs(lower), 0.0) + np.where(np.isfinite(upper), np.abs(upper), 0.0))
-
-    def solve_free():
-        F = st == 0
-        r = b - A[:, ~F] @ x[~F]
-        return F, _minnorm(A[:, F], r)
-
-    for _ in range(n + 1):                   # phase 1: exclusion
-        F, z = solve_free()
-        x[F] = z
-        vlo = F & (x < lower - slack)
-        vhi = F & (x > upper + slack)
-        if not (vlo.any() or vhi.any()):
-            break
-        st[vlo], x[vlo] = -1, lower[vlo]
-        st[vhi], x[vhi] = 1, upper[vhi]
-    x = np.clip(x, lower, upper)
-    max_iter = max_iter or 20 + 10 * n
-    for _ in range(max_iter):                # phase 2: re-admission
-        g = A.T @ (b - A @ x)                # -gradient: moving x_i by +d reduces the objective if g_i d > 0
-        scale = 1e-9 * (np.linalg.norm(A, axis=0) * np.linalg.norm(b - A @ x) + 1e-300)
-        cand = ((st == -1) & (g > scale) & ~pt) | ((st == 1) & (g < -scale) & ~pt)
-        if not cand.any():
-            break
-        i = int(np.argmax(np.where(cand, np.abs(g), -1.0)))
-        st[i] = 0
-        for _ in range(n + 1):               # step towards the free-set solution, fix blockers
-            F, z = solve_free()
-            xf = x[F]
-            d = z - xf
-            lo_f, hi_f = lower[F], upper[F]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                t_hi = np.where(d > 0, (hi_f - xf) / d, np.inf)
-                t_lo = np.where(d < 0, (lo_f - xf) / d, np.inf)
-            t = np.minimum(t_hi, t_lo)
-            alpha = min(1.0, float(t.min()) if len(t) else 1.0)
-            x[F] = np.clip(xf + alpha * d, lo_f, hi_f)
-            if alpha >= 1.0:
-                break
-            fidx = np.nonzero(F)[0]
-            blk = fidx[t <= alpha + 1e-15]
-            for j in blk:
-                st[j] = -1 if d[np.searchsorted(fidx, j)] < 0 else 1
-                x[j] = lower[j] if st[j] == -1 else upper[j]
-    return x
+def box_lsq(A: np.ndarray, b: np.ndarray, lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """min 1/2 |b - A x|^2 s.t. lower <= x <= upper: the seed's coordinate exclusion done as an
+    active set with re-admission (the C++ reference ``pinv.hpp`` box_lsq, Exclusion::ActiveSet)."""
+    return np.asarray(_model.box_lsq(np.asarray(A, float), np.asarray(b, float), np.asarray(lower, float),
+                                     np.asarray(upper, float))["qd"])
 
 
 def dls_solve(A: np.ndarray, b: np.ndarray, lower: np.ndarray, upper: np.ndarray, lambda_max: float,
               eps: float) -> np.ndarray:
     """Damped least squares with adaptive damping (Nakamura-Hanafusa / Maciejewski-Klein):
     lambda^2 = lambda_max^2 (1 - (sigma_min / eps)^2) when sigma_min < eps, else 0, sigma_min the
-    min(6, n)-th singular value; min |b - A x|^2 + lambda^2 |x|^2 on the box = box_lsq of
-    [A; lambda I] x = [b; 0]."""
-    n = A.shape[1]
-    s = np.linalg.svd(A, compute_uv=False)
-    smin = s[min(6, n) - 1] if len(s) else 0.0
-    lam = lambda_max * math.sqrt(max(0.0, 1.0 - (smin / eps) ** 2)) if smin < eps else 0.0
-    if lam == 0.0:
-        return box_lsq(A, b, lower, upper)
-    Ad = np.vstack([A, lam * np.eye(n)])
-    bd = np.concatenate([b, np.zeros(n)])
-    return box_lsq(Ad, bd, lower, upper)
+    min(6, n)-th singular value of A (the C++ reference ``pinv.hpp`` dls_solve; A is already
+    weighted, so L = 1 there)."""
+    return np.asarray(_model.dls_solve(np.asarray(A, float), np.asarray(b, float), 1.0, float(lambda_max), float(eps),
+                                       np.asarray(lower, float), np.asarray(upper, float))["qd"])
 
 
 # ---- float errors (honest, independent of the model) -----------------------------------------------
