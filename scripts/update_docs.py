@@ -28,7 +28,8 @@ DOC = ROOT / "docs" / "numerics.md"
 # Signal classes of formats.hpp: (name, meaning, range argument, multiplier operand?)
 SIGNALS = [
     ("angle_t", "joint value q (input), joint units", "limits checked at configuration", True),
-    ("kturn_t", "s/(4 pi): joint unit -> half-angle turns (constant)", "|s| checked", True),
+    ("kturn_t", "s/(4 pi): joint unit -> half-angle turns (derived at commit: s x 1/(4 pi))", "|s| checked", True),
+    ("inv4pi_t", "constant 1/(4 pi) (derivation of kturn)", "constant", True),
     ("turn_t", "half angle in turns, modulo one turn (wraps by definition)", "wraps", False),
     ("scale_t", "joint scale s (constant)", "|s| checked", True),
     ("tab_t", "quarter-wave table entries sin/cos", "[0, 1]", True),
@@ -57,6 +58,7 @@ SIGNALS = [
     ("mu_t", "per-joint multiplier (relaxation)", "[0, 2)", True),
     ("step_t", "mu_i / mant_i", "[0, 2)", True),
     ("klim_t", "limit-approach gain (1/s)", "checked", True),
+    ("qdiff_t", "limit minus q, operand of the limit-approach product", "< 16 (default exact)", True),
     ("gain_t", "servo gains K_p, K_o (1/s)", "checked", True),
     ("dt_t", "tick period (s)", "checked", True),
     ("vel_t", "setpoint twist U' and command V", "saturates, flagged", True),
@@ -64,6 +66,7 @@ SIGNALS = [
     ("rot_t", "orientation error, rotation vector (rad)", "|.| <= pi", True),
     ("rvf_t", "phi/sin(phi) table and interpolation (rotation vector)", "[1, pi/2]", True),
     ("tacc_t", "exact accumulator of the solver residual", "exact, n <= 64", False),
+    ("weight_t", "per-task row weight (trees of chains)", "[0, 4)", True),
 ]
 
 METRIC_LABELS = [("pos", "position (m)"), ("rot", "orientation (rad)"), ("jac", "J element, root axes"),

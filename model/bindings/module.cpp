@@ -207,7 +207,7 @@ py::dict formats_of() {
   TS_FMT(lever_t) TS_FMT(jw_t) TS_FMT(jv_t) TS_FMT(jw_tmp_t) TS_FMT(jv_tmp_t) TS_FMT(twopi_t) TS_FMT(sixth_t)
   TS_FMT(lchar_t) TS_FMT(tw_t) TS_FMT(jsc_t) TS_FMT(qd_t) TS_FMT(gk_t) TS_FMT(mant_t) TS_FMT(recip_t) TS_FMT(mu_t)
   TS_FMT(step_t) TS_FMT(klim_t) TS_FMT(gain_t) TS_FMT(dt_t) TS_FMT(vel_t) TS_FMT(perr_t) TS_FMT(rot_t) TS_FMT(rvf_t)
-  TS_FMT(tacc_t)
+  TS_FMT(tacc_t) TS_FMT(qdiff_t) TS_FMT(inv4pi_t) TS_FMT(weight_t)
 #undef TS_FMT
   d["TRIG_TABLE_BITS"] = Fmt::TRIG_TABLE_BITS;
   d["RECIP_TABLE_BITS"] = Fmt::RECIP_TABLE_BITS;

@@ -60,6 +60,7 @@ struct FmtDouble {
   using mu_t = double;
   using step_t = double;
   using klim_t = double;
+  using qdiff_t = double;
   using gain_t = double;
   using dt_t = double;
   using vel_t = double;
@@ -114,6 +115,7 @@ struct FmtDefaultT {
   using mu_t = N<18, 2, ST_OVF_CONST>;         // per-joint multiplier (relaxation), [0, 2)
   using step_t = N<18, 2, ST_OVF_SOLVER>;      // mu_i / mant_i
   using klim_t = N<27, 15, ST_OVF_CONST>;      // limit-approach gain (1/s)
+  using qdiff_t = N<33, 5, ST_OVF_SOLVER>;     // limit - q, exact (33-bit operand: 4 MULT18X18D)
   using gain_t = N<27, 15, ST_OVF_CONST>;      // servo gains K_p, K_o (1/s)
   using dt_t = N<32, -3, ST_OVF_CONST>;        // tick period (s), < 1/8 s
   using vel_t = N<27, 6, ST_OVF_SERVO>;        // setpoint twist U' and command V (omega; v), |.| < 32
@@ -166,6 +168,7 @@ struct FmtCompactT {
   using mu_t = N<18, 2, ST_OVF_CONST>;
   using step_t = N<18, 2, ST_OVF_SOLVER>;
   using klim_t = N<18, 15, ST_OVF_CONST>;
+  using qdiff_t = N<18, 5, ST_OVF_SOLVER>;     // limit - q rounded to an 18-bit operand
   using gain_t = N<18, 15, ST_OVF_CONST>;
   using dt_t = N<18, -3, ST_OVF_CONST>;
   using vel_t = N<18, 6, ST_OVF_SERVO>;

@@ -178,8 +178,9 @@ inline void solver_steps(const SolverParams<Fmt, NMAX>& P, const typename Fmt::a
     if (P.limited[i]) {
       // Compared exactly before narrowing: a bound beyond the velocity interval is inactive and
       // never needs to be represented (no spurious saturation for wide ranges or large klim).
-      const auto plo = P.klim * (P.lo[i] - q[i]);
-      const auto phi = P.klim * (P.hi[i] - q[i]);
+      using qdiff_t = typename Fmt::qdiff_t;  // default: exact; compact: rounded to 18 bits
+      const auto plo = P.klim * cvt<qdiff_t>(P.lo[i] - q[i], st);
+      const auto phi = P.klim * cvt<qdiff_t>(P.hi[i] - q[i], st);
       if (vmin < plo) { C.lo[i] = vmax < plo ? vmax : cvt<qd_t>(plo, st); C.lo_pos[i] = true; }
       if (phi < vmax) { C.hi[i] = phi < vmin ? vmin : cvt<qd_t>(phi, st); C.hi_pos[i] = true; }
     }
