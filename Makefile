@@ -57,7 +57,12 @@ BIND_SRCS  := $(wildcard model/bindings/*.cpp)
 BIND_OBJS  := $(patsubst model/bindings/%.cpp,$(BUILD)/bindings/%.o,$(BIND_SRCS))
 BIND_STAMP := $(BUILD)/.bindings.stamp
 
-build: $(BUILD)/model_tests/run_tests $(BIND_STAMP)
+build: $(BUILD)/model_tests/run_tests $(BUILD)/model_tests/operand_widths $(BIND_STAMP)
+
+# Operand-width audit: its own program (TS_AUDIT_MUL changes the model's operator*).
+$(BUILD)/model_tests/operand_widths: model/tests/audit/operand_widths.cpp $(MODEL_HDRS) | $(STAMP_VENV)
+	@mkdir -p $(@D)
+	$(CXX) $(CXXSTD) $(CXXOPT) $(CXXWARN) -DTS_AUDIT_MUL $(INCLUDES) $< -o $@
 
 # Xilinx's ap_types headers warn under -Wall; they are third-party (-isystem) and quietened here.
 AP_QUIET := -Wno-uninitialized -Wno-maybe-uninitialized
@@ -84,10 +89,12 @@ $(BIND_STAMP): $(BIND_OBJS)
 # ---- tests ---------------------------------------------------------------------------------------
 test: setup
 	$(BUILD)/model_tests/run_tests
+	$(BUILD)/model_tests/operand_widths
 	$(PY) -m pytest -n $(JOBS) -q
 
 test-cpp: build
 	$(BUILD)/model_tests/run_tests
+	$(BUILD)/model_tests/operand_widths
 
 test-py: build
 	$(PY) -m pytest -n $(JOBS) -q

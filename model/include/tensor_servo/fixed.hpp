@@ -144,8 +144,19 @@ constexpr int64_t shl(int64_t v, int k) { return v * (int64_t(1) << k); }
 }  // namespace detail
 
 // ---- exact arithmetic (result formats as ap_fixed) ---------------------------------------------
+#ifdef TS_AUDIT_MUL
+// Audit build (model/tests/audit/): every product records the wider of its two operand formats,
+// so a test can prove a configuration's multiplier operands never exceed a width.
+namespace audit { inline int max_operand_width = 0; }
+#define TS_MUL_CONSTEXPR
+#else
+#define TS_MUL_CONSTEXPR constexpr
+#endif
 template <int W1, int I1, uint32_t L1, int W2, int I2, uint32_t L2>
-constexpr fx<W1 + W2, I1 + I2> operator*(fx<W1, I1, L1> a, fx<W2, I2, L2> b) {
+TS_MUL_CONSTEXPR fx<W1 + W2, I1 + I2> operator*(fx<W1, I1, L1> a, fx<W2, I2, L2> b) {
+#ifdef TS_AUDIT_MUL
+  audit::max_operand_width = audit::max_operand_width > (W1 > W2 ? W1 : W2) ? audit::max_operand_width : (W1 > W2 ? W1 : W2);
+#endif
   return fx<W1 + W2, I1 + I2>::from_raw(a.raw * b.raw);
 }
 
