@@ -28,6 +28,7 @@ struct ServoBase {
   virtual py::dict ik(const f64arr& q0, const f64arr& tq, const f64arr& tp, int max_ticks, double tol_pos,
                       double tol_rot) const = 0;
   virtual py::dict params_raw() const = 0;
+  virtual py::dict solve_raw(const i64arr& J, const i64arr& V, const i64arr& q, const i64arr& warm) const = 0;
 };
 
 template <class T> T param(const py::dict& d, const char* key, Status& st) {
@@ -49,6 +50,7 @@ struct Servo final : ServoBase {
   ChainQ<Fmt, NMAX> ch;
   ServoParams<Fmt, NMAX> P;  // TMAX = 4 tasks (trees of chains)
 
+  Servo(const ChainQ<Fmt, NMAX>& c, const ServoParams<Fmt, NMAX>& p) : ch(c), P(p) {}
   Servo(const ChainSpec& spec, const py::dict& pd) {
     const ConfigResult r = configure_chain<Fmt, NMAX>(spec, ch);
     if (!r.ok()) throw std::invalid_argument(r.field + ": " + r.message);
@@ -172,6 +174,20 @@ struct Servo final : ServoBase {
     py::dict d("qd"_a = qd, "q_next"_a = qn, "ep"_a = ep, "eo"_a = eo, "r"_a = r, "flags"_a = st.flags);
     if (!Fmt::is_float) {
       d["qd_raw"] = qd_r; d["q_next_raw"] = qn_r; d["ep_raw"] = ep_r; d["eo_raw"] = eo_r; d["r_raw"] = r_r;
+      // intermediate results for the RTL engines: each task's Jacobian (rows omega; v, in the basis
+      // its error uses), commanded twist, and the tool pose
+      i64arr J_r(shp(T, 6, n)), V_r(shp(T, 6)), tq(shp(4)), tp(shp(3));
+      for (int t = 0; t < T; ++t) {
+        for (int i = 0; i < n; ++i)
+          for (int a = 0; a < 3; ++a) {
+            J_r.mutable_at(t, a, i) = raw_of(R->J[t].w[i].c[a]);
+            J_r.mutable_at(t, a + 3, i) = raw_of(R->J[t].v[i].c[a]);
+          }
+        for (int a = 0; a < 3; ++a) { V_r.mutable_at(t, a) = raw_of(R->V_w[t].c[a]); V_r.mutable_at(t, a + 3) = raw_of(R->V_v[t].c[a]); }
+      }
+      for (int a = 0; a < 4; ++a) tq.mutable_at(a) = raw_of(R->frames.Q[n + 1].c[a]);
+      for (int a = 0; a < 3; ++a) tp.mutable_at(a) = raw_of(R->frames.p[n + 1].c[a]);
+      d["J_raw"] = J_r; d["V_raw"] = V_r; d["tool_quat_raw"] = tq; d["tool_pos_raw"] = tp;
     }
     return d;
   }
@@ -217,6 +233,35 @@ struct Servo final : ServoBase {
     return py::dict("q"_a = qo, "ticks"_a = ticks, "converged"_a = conv, "flags"_a = flags);
   }
 
+  // The back half of a tick alone (one task): Jacobian J (6, n) raw (rows omega: jw_t, v: jv_t),
+  // commanded twist V (6,) raw (vel_t), q (n,) raw, warm start (n,) raw -> q', q_next, r, flags.
+  py::dict solve_raw(const i64arr& J, const i64arr& V, const i64arr& q, const i64arr& warm) const override {
+    if constexpr (Fmt::is_float) { throw std::invalid_argument("solve_raw needs a fixed-point configuration"); }
+    else {
+      const int n = ch.n;
+      if (P.ntasks != 1) throw std::invalid_argument("solve_raw: one task");
+      need_shape(J, {6, n}, "J"); need_shape(V, {6}, "V"); need_shape(q, {n}, "q"); need_shape(warm, {n}, "warm");
+      auto R = std::make_unique<TickResult<Fmt, NMAX>>();
+      R->J[0].n = n;
+      angle_t qq[NMAX]; qd_t w[NMAX];
+      for (int i = 0; i < n; ++i) {
+        for (int a = 0; a < 3; ++a) {
+          R->J[0].w[i].c[a] = of_raw<typename Fmt::jw_t>(J.at(a, i));
+          R->J[0].v[i].c[a] = of_raw<typename Fmt::jv_t>(J.at(a + 3, i));
+        }
+        qq[i] = of_raw<angle_t>(q.at(i));
+        w[i] = of_raw<qd_t>(warm.at(i));
+      }
+      for (int a = 0; a < 3; ++a) { R->V_w[0].c[a] = of_raw<vel_t>(V.at(a)); R->V_v[0].c[a] = of_raw<vel_t>(V.at(a + 3)); }
+      Status st;
+      servo_back(P, n, qq, w, *R, st);
+      i64arr qd(shp(n)), qn(shp(n)), r(shp(6));
+      for (int i = 0; i < n; ++i) { qd.mutable_at(i) = raw_of(R->qd[i]); qn.mutable_at(i) = raw_of(R->q_next[i]); }
+      for (int a = 0; a < 6; ++a) r.mutable_at(a) = raw_of(R->r[a]);
+      return py::dict("qd_raw"_a = qd, "q_next_raw"_a = qn, "r_raw"_a = r, "flags"_a = st.flags);
+    }
+  }
+
   py::dict params_raw() const override {
     const int n = ch.n;
     i64arr mu(shp(n)), lo(shp(n)), hi(shp(n)), vmax(shp(n));
@@ -242,6 +287,59 @@ std::unique_ptr<ServoBase> make_servo(const std::string& cfg, const py::dict& sp
   throw std::invalid_argument("config: unknown configuration '" + cfg + "' (double, default, compact)");
 }
 
+// The core's commit step on raw register words (core_config.hpp commit_config).  raw: dict with
+// n, mode, sweeps, warm_leak, kp, ko, lchar, klim, dt, base_q (4), base_p (3), tool_q, tool_p,
+// joints: list of dicts {jcfg, qo (4), po (3), axis (3), scale, lower, upper, vmax, mu}.
+RawConfig raw_from_dict(const py::dict& d) {
+  RawConfig rc;
+  rc.n = d["n"].cast<int>();
+  rc.mode = d["mode"].cast<uint32_t>();
+  rc.sweeps = d["sweeps"].cast<int>();
+  rc.warm_leak = d["warm_leak"].cast<int>();
+  rc.kp = d["kp"].cast<int64_t>(); rc.ko = d["ko"].cast<int64_t>(); rc.lchar = d["lchar"].cast<int64_t>();
+  rc.klim = d["klim"].cast<int64_t>(); rc.dt = d["dt"].cast<int64_t>();
+  auto arr = [](const py::handle& h, int64_t* out, size_t k) {
+    auto v = h.cast<std::vector<int64_t>>();
+    if (v.size() != k) throw std::invalid_argument("raw config: wrong vector length");
+    for (size_t i = 0; i < k; ++i) out[i] = v[i];
+  };
+  arr(d["base_q"], rc.base_q, 4); arr(d["base_p"], rc.base_p, 3); arr(d["tool_q"], rc.tool_q, 4); arr(d["tool_p"], rc.tool_p, 3);
+  for (const auto& jh : d["joints"].cast<py::list>()) {
+    const py::dict jd = jh.cast<py::dict>();
+    RawJoint j;
+    j.jcfg = jd["jcfg"].cast<uint32_t>();
+    arr(jd["qo"], j.qo, 4); arr(jd["po"], j.po, 3); arr(jd["axis"], j.axis, 3);
+    j.scale = jd["scale"].cast<int64_t>(); j.lower = jd["lower"].cast<int64_t>(); j.upper = jd["upper"].cast<int64_t>();
+    j.vmax = jd["vmax"].cast<int64_t>(); j.mu = jd["mu"].cast<int64_t>();
+    rc.joints.push_back(j);
+  }
+  return rc;
+}
+
+template <class Fmt>
+py::tuple commit_impl(const py::dict& raw, int core_nmax) {
+  const RawConfig rc = raw_from_dict(raw);
+  ChainQ<Fmt, NMAX, 1> ch1;
+  ServoParams<Fmt, NMAX, 1> p1;
+  // The core's NMAX bounds the joint count; the model arrays are NMAX = 64 wide.
+  ConfigResult r;
+  if (rc.n > core_nmax) { r.code = CFG_JOINT_COUNT; r.field = "NJOINTS"; r.message = "joint count above the core's NMAX"; }
+  else r = commit_config<Fmt, NMAX>(rc, ch1, p1);
+  py::dict res("code"_a = static_cast<int>(r.code), "joint"_a = r.joint, "field"_a = r.field, "message"_a = r.message);
+  if (!r.ok()) return py::make_tuple(res, py::none());
+  std::vector<int64_t> k;
+  for (int i = 0; i < ch1.n; ++i) k.push_back(raw_of(ch1.j[i].k));
+  res["kturn_raw"] = k;
+  // A Servo (TMAX = 4 build) holding the committed state.
+  ChainQ<Fmt, NMAX> ch;
+  ServoParams<Fmt, NMAX> P;
+  ch.n = ch1.n; ch.ntips = 1; ch.qb = ch1.qb; ch.pb = ch1.pb; ch.qt[0] = ch1.qt[0]; ch.pt[0] = ch1.pt[0]; ch.tip_parent[0] = ch1.tip_parent[0];
+  for (int i = 0; i < ch1.n; ++i) { ch.j[i] = ch1.j[i]; ch.parent[i] = ch1.parent[i]; }
+  P.solver = p1.solver; P.kp = p1.kp; P.ko = p1.ko; P.dt = p1.dt; P.mode = p1.mode; P.feedforward = p1.feedforward;
+  P.ntasks = 1; P.controlled[0] = -1; P.setpoint_frame = -1; P.warm_leak = p1.warm_leak;
+  return py::make_tuple(res, py::cast(static_cast<ServoBase*>(new Servo<Fmt>(ch, P)), py::return_value_policy::take_ownership));
+}
+
 }  // namespace
 
 void bind_servo(py::module_& m) {
@@ -254,5 +352,13 @@ void bind_servo(py::module_& m) {
                           const py::array& uw, const py::array& uv, const py::array& w) { return s.tick(q, uq, up, uw, uv, w, true); })
       .def("ik", &ServoBase::ik, py::arg("q0"), py::arg("T_quat"), py::arg("T_pos"), py::arg("max_ticks"),
            py::arg("tol_pos"), py::arg("tol_rot"))
-      .def("params_raw", &ServoBase::params_raw);
+      .def("params_raw", &ServoBase::params_raw)
+      .def("solve_raw", &ServoBase::solve_raw, py::arg("J"), py::arg("V"), py::arg("q"), py::arg("warm"));
+  m.def("commit_raw", [](const std::string& cfg, const py::dict& raw, int core_nmax) -> py::tuple {
+    if (core_nmax < 1 || core_nmax > NMAX) throw std::invalid_argument("core_nmax: 1..64");
+    if (cfg == "default") return commit_impl<FmtDefault>(raw, core_nmax);
+    if (cfg == "compact") return commit_impl<FmtCompact>(raw, core_nmax);
+    throw std::invalid_argument("config: default or compact");
+  }, py::arg("config"), py::arg("raw"), py::arg("core_nmax") = 8,
+     "The servo core's commit step on raw register words: (result dict, Servo or None).");
 }

@@ -107,7 +107,8 @@ struct TickResult {
   Vec3<typename Fmt::rot_t> eo[TMAX];   // orientation error (rotation vector) of each task
   typename Fmt::tw_t r[6 * TMAX];   // final scaled residual of the solver
   Frames<Fmt, NMAX, TMAX> frames;
-  Jacobian<Fmt, NMAX> J[TMAX];
+  Jacobian<Fmt, NMAX> J[TMAX];      // each task's Jacobian, in the basis its error uses
+  Vec3<typename Fmt::vel_t> V_w[TMAX], V_v[TMAX];  // each task's commanded twist (omega; v)
 };
 
 // Error and commanded twist of one task (controlled frame ctl, setpoint U); fills the task's
@@ -181,28 +182,35 @@ inline T warm_leak(const T& x, int s) {
   else return T::from_raw(raw_of(x) - (raw_of(x) >> s));
 }
 
-// One servo tick.  U: one setpoint per task; qd_warm: the previous tick's q' (warm start).
+// The front half of a tick: FK, each task's error, Jacobian and commanded twist (into R).
 template <class Fmt, int NMAX, int TMAX>
-inline void servo_tick(const ChainQ<Fmt, NMAX, TMAX>& ch, const ServoParams<Fmt, NMAX, TMAX>& P,
-                       const typename Fmt::angle_t* q, const Setpoint<Fmt>* U, const typename Fmt::qd_t* qd_warm,
-                       TickResult<Fmt, NMAX, TMAX>& R, Status& st) {
-  using vel_t = typename Fmt::vel_t;
-  using tw_t = typename Fmt::tw_t;
+inline void servo_front(const ChainQ<Fmt, NMAX, TMAX>& ch, const ServoParams<Fmt, NMAX, TMAX>& P,
+                        const typename Fmt::angle_t* q, const Setpoint<Fmt>* U, TickResult<Fmt, NMAX, TMAX>& R,
+                        Status& st) {
   const int n = ch.n;
-  const int T = P.ntasks;
   forward_kinematics(ch, q, R.frames, st);
+  for (int t = 0; t < TMAX; ++t) {
+    if (t >= P.ntasks) continue;
+    const int ctl = P.controlled[t] < 0 ? n + 1 + t : P.controlled[t];
+    task_error(ch, P, R.frames, ctl, U[t], R.ep[t], R.eo[t], R.V_w[t], R.V_v[t], R.J[t], st);
+  }
+}
 
+// The back half: the solve of the stacked tasks (R.J, R.V_w, R.V_v) and the virtual-mode
+// integration; qd_warm: the previous tick's q' (warm start).
+template <class Fmt, int NMAX, int TMAX>
+inline void servo_back(const ServoParams<Fmt, NMAX, TMAX>& P, int n, const typename Fmt::angle_t* q,
+                       const typename Fmt::qd_t* qd_warm, TickResult<Fmt, NMAX, TMAX>& R, Status& st) {
+  using tw_t = typename Fmt::tw_t;
+  const int T = P.ntasks;
   SolverColumns<Fmt, NMAX, 6 * TMAX> C;
   C.rows = 6 * T;
   tw_t vs[6 * TMAX];
   for (int t = 0; t < TMAX; ++t) {
     if (t >= T) continue;
-    const int ctl = P.controlled[t] < 0 ? n + 1 + t : P.controlled[t];
-    Vec3<vel_t> V_w, V_v;
-    task_error(ch, P, R.frames, ctl, U[t], R.ep[t], R.eo[t], V_w, V_v, R.J[t], st);
     // Scaled (and, for several tasks, weighted) target and columns of this task.
     const typename Fmt::weight_t* w = T > 1 ? &P.weight[t] : nullptr;
-    solver_target(P.solver, V_w, V_v, t, w, vs, st);
+    solver_target(P.solver, R.V_w[t], R.V_v[t], t, w, vs, st);
     solver_columns(P.solver, R.J[t], t, w, C, st);
   }
   solver_steps(P.solver, q, n, C, st);
@@ -218,6 +226,15 @@ inline void servo_tick(const ChainQ<Fmt, NMAX, TMAX>& ch, const ServoParams<Fmt,
     if (P.solver.limited[i]) qn = tmax(P.solver.lo[i], tmin(qn, P.solver.hi[i]));
     R.q_next[i] = qn;
   }
+}
+
+// One servo tick.  U: one setpoint per task; qd_warm: the previous tick's q' (warm start).
+template <class Fmt, int NMAX, int TMAX>
+inline void servo_tick(const ChainQ<Fmt, NMAX, TMAX>& ch, const ServoParams<Fmt, NMAX, TMAX>& P,
+                       const typename Fmt::angle_t* q, const Setpoint<Fmt>* U, const typename Fmt::qd_t* qd_warm,
+                       TickResult<Fmt, NMAX, TMAX>& R, Status& st) {
+  servo_front(ch, P, q, U, R, st);
+  servo_back(P, ch.n, q, qd_warm, R, st);
 }
 
 }  // namespace ts
