@@ -313,6 +313,18 @@ py::tuple prim_screw(const py::array_t<bool>& prismatic, const i64arr& s_raw, co
   return py::make_tuple(w, v, fl);
 }
 
+// The solver's reciprocal table and the rotation vector's phi/sin(phi) table (f, df), raw.
+template <class Fmt>
+py::dict solver_tables() {
+  constexpr int NR = 1 << Fmt::RECIP_TABLE_BITS, NV = 1 << Fmt::ROTVEC_TABLE_BITS;
+  i64arr y(shp(NR)), f(shp(NV + 1)), df(shp(NV + 1));
+  for (int j = 0; j < NR; ++j) y.mutable_at(j) = RecipTable<Fmt>::at(j).raw;
+  for (int j = 0; j <= NV; ++j) { f.mutable_at(j) = RotvecTable<Fmt>::f_at(j).raw; df.mutable_at(j) = RotvecTable<Fmt>::df_at(j).raw; }
+  Status st;
+  const auto inv = Fmt::inv4pi_t::from_double(1.0 / (4.0 * kPi), st);
+  return py::dict("recip"_a = y, "rotvec_f"_a = f, "rotvec_df"_a = df, "inv4pi"_a = inv.raw);
+}
+
 template <class Fmt>
 py::tuple trig_table() {
   const auto& t = TrigTable<Fmt>::get();
@@ -339,6 +351,7 @@ PYBIND11_MODULE(_model, m) {
       .def("constants", &ModelBase::constants);
   m.def("formats", [](const std::string& cfg) { return dispatch_fixed(cfg, [](auto f) { return formats_of<decltype(f)>(); }); });
   m.def("trig_table", [](const std::string& cfg) { return dispatch_fixed(cfg, [](auto f) { return trig_table<decltype(f)>(); }); });
+  m.def("solver_tables", [](const std::string& cfg) { return dispatch_fixed(cfg, [](auto f) { return solver_tables<decltype(f)>(); }); });
   m.def("prim_qmul", [](const std::string& cfg, const i64arr& a, const i64arr& b) {
     return dispatch_fixed(cfg, [&](auto f) { return prim_qmul<decltype(f)>(a, b); });
   });

@@ -1,0 +1,30 @@
+// tensor-servo: constant functions shared by the datapath modules (included inside module bodies).
+// Language: Verilog 2005
+
+// Latency of ts_mul in clock cycles for operand widths aw x bw, for every TARGET: 3 register
+// stages (input, product, output); with an operand wider than 18 bits one more for the fabric
+// register after the ECP5 partial products and one adder level per wide operand (the GENERIC
+// target pads with registers to the same latency).
+function integer ts_mul_lat;
+  input integer aw;
+  input integer bw;
+  begin
+    ts_mul_lat = 3 + (((aw > 18) || (bw > 18)) ? 1 : 0) + ((aw > 18) ? 1 : 0) + ((bw > 18) ? 1 : 0);
+  end
+endfunction
+
+function integer ts_max;
+  input integer x;
+  input integer y;
+  begin
+    ts_max = (x > y) ? x : y;
+  end
+endfunction
+
+// Latency of ts_round_sat in clock cycles (for either mode sat = 1 / 0).
+function integer ts_round_lat;
+  input integer sat;
+  begin
+    ts_round_lat = (sat >= 0) ? 2 : 2;
+  end
+endfunction

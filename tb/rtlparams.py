@@ -1,0 +1,277 @@
+"""Verilog parameters of the tensor-servo datapath modules, derived from the model's formats.
+
+The C++ model (``tensor_servo._model.formats(cfg)``) is the single source of every width: this module
+turns its ``(W, I)`` pairs (ap_fixed<W, I>, F = W - I) into the parameter sets of the RTL modules and
+states each module's latency (the same formula as the module's ``LATENCY`` localparam; the benches
+check it cycle by cycle).  Used by the cocotb benches, ``scripts/lint_rtl.sh``, ``scripts/synth.py``
+and ``scripts/gen_rtl_data.py``.
+"""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+RTL = ROOT / "rtl"
+SIM_MODELS = ROOT / "tb" / "sim"
+
+CONFIGS = ("default", "compact")
+TARGETS = ("GENERIC", "ECP5")
+#: rotate kinds: (vector, tmp, out) formats, as in model/bindings/module.cpp prim_rotate
+ROTATE_KINDS = {
+    "axis": ("quat_t", "uvec_tmp_t", "quat_t"),
+    "offset": ("len_t", "len_tmp_t", "pos_t"),
+    "jw": ("jw_t", "jw_tmp_t", "jw_t"),
+    "jv": ("jv_t", "jv_tmp_t", "jv_t"),
+}
+
+_FORMATS: dict[str, dict] = {}
+
+
+def formats(cfg: str) -> dict:
+    if cfg not in _FORMATS:
+        from tensor_servo import _model
+        _FORMATS[cfg] = dict(_model.formats(cfg))
+    return _FORMATS[cfg]
+
+
+def fmt(cfg: str, name: str) -> tuple[int, int]:
+    """(W, F) of a model format."""
+    w, i = formats(cfg)[name]
+    return int(w), int(w - i)
+
+
+def quantize_const(x: float, cfg: str, name: str) -> int:
+    """Raw value of a constant exactly as fx<W,I>::from_double (floor(x 2^F + 1/2), then AP_SAT)."""
+    w, f = fmt(cfg, name)
+    r = math.floor(math.ldexp(x, f) + 0.5)
+    return max(-(1 << (w - 1)), min((1 << (w - 1)) - 1, r))
+
+
+def mul_lat(aw: int, bw: int) -> int:
+    """ts_mul latency (rtl/ts_common.vh ts_mul_lat)."""
+    return 3 + (aw > 18 or bw > 18) + (aw > 18) + (bw > 18)
+
+
+#: ts_round_sat latency (rtl/ts_common.vh ts_round_lat)
+ROUND_LAT = 2
+
+
+def vstr(s: str) -> str:
+    """A Verilog string parameter value for -G / -P / chparam."""
+    return '"' + s + '"'
+
+
+# ---- per-module parameter sets ------------------------------------------------------------------
+def quat_mul(cfg: str, target: str = "GENERIC") -> dict:
+    qw, qf = fmt(cfg, "quat_t")
+    return {"Q_W": qw, "Q_F": qf, "TARGET": target}
+
+
+def quat_rotate(cfg: str, kind: str = "axis", inverse: bool = False, target: str = "GENERIC") -> dict:
+    vn, tn, on = ROTATE_KINDS[kind]
+    qw, qf = fmt(cfg, "quat_t")
+    vw, vf = fmt(cfg, vn)
+    tw, tf = fmt(cfg, tn)
+    ow, of = fmt(cfg, on)
+    return {"Q_W": qw, "Q_F": qf, "V_W": vw, "V_F": vf, "T_W": tw, "T_F": tf, "O_W": ow, "O_F": of,
+            "INV": int(bool(inverse)), "TARGET": target}
+
+
+def rom_file(cfg: str) -> Path:
+    return RTL / f"ts_trig_rom_{cfg}.mem"
+
+
+def sincos(cfg: str, target: str = "GENERIC", rom_path: str | None = None) -> dict:
+    fm = formats(cfg)
+    uw, _ = fmt(cfg, "turn_t")
+    p = {"U_W": uw, "T_BITS": int(fm["TRIG_TABLE_BITS"])}
+    for key, name in (("TAB", "tab_t"), ("DELTA", "delta_t"), ("DSQ", "dsq_t"), ("ACC", "trig_acc_t"),
+                      ("Q", "quat_t"), ("TWOPI", "twopi_t"), ("SIXTH", "sixth_t")):
+        w, f = fmt(cfg, name)
+        p[f"{key}_W"], p[f"{key}_F"] = w, f
+    p["TWOPI"] = quantize_const(2.0 * math.pi, cfg, "twopi_t")
+    p["SIXTH"] = quantize_const(1.0 / 6.0, cfg, "sixth_t")
+    p["ROM_FILE"] = rom_path if rom_path is not None else rom_file(cfg).name
+    p["TARGET"] = target
+    return p
+
+
+def joint_quat(cfg: str, target: str = "GENERIC", rom_path: str | None = None) -> dict:
+    aw, af = fmt(cfg, "angle_t")
+    kw, kf = fmt(cfg, "kturn_t")
+    p = {"ANG_W": aw, "ANG_F": af, "KT_W": kw, "KT_F": kf}
+    p.update(sincos(cfg, target, rom_path))
+    return p
+
+
+def screw_transport(cfg: str, target: str = "GENERIC") -> dict:
+    p = {}
+    for key, name in (("Q", "quat_t"), ("UT", "uvec_tmp_t"), ("S", "scale_t"), ("P", "pos_t"),
+                      ("L", "lever_t"), ("JW", "jw_t"), ("JV", "jv_t")):
+        w, f = fmt(cfg, name)
+        p[f"{key}_W"], p[f"{key}_F"] = w, f
+    p["TARGET"] = target
+    return p
+
+
+# ---- latencies (documented; the benches check them) -------------------------------------------------
+def latency(module: str, p: dict) -> int:
+    rl = ROUND_LAT
+    if module == "ts_quat_mul":
+        return mul_lat(p["Q_W"], p["Q_W"]) + 2 + rl
+    if module == "ts_quat_rotate":
+        return mul_lat(p["Q_W"], p["V_W"]) + mul_lat(p["Q_W"], p["T_W"]) + 3 + 2 * rl
+    if module == "ts_sincos":
+        return sincos_stages(p)["LATENCY"]
+    if module == "ts_joint_quat":
+        return (mul_lat(p["ANG_W"], p["KT_W"]) + rl + latency("ts_sincos", p)
+                + mul_lat(p["Q_W"], p["Q_W"]) + rl)
+    if module == "ts_screw_transport":
+        lr = mul_lat(p["Q_W"], p["Q_W"]) + mul_lat(p["Q_W"], p["UT_W"]) + 3 + 2 * rl
+        cw = lr + mul_lat(p["S_W"], p["Q_W"]) + rl
+        return cw + mul_lat(p["JW_W"], p["L_W"]) + 1 + rl + 1
+    raise KeyError(module)
+
+
+def sincos_stages(p: dict) -> dict:
+    """Cycle at which each ts_sincos signal is available (input u at cycle 0)."""
+    rl = ROUND_LAT
+    r = p["U_W"] - 2 - p["T_BITS"]
+    c = {}
+    c["d"] = mul_lat(r + 1, p["TWOPI_W"]) + rl
+    c["d2"] = c["d"] + mul_lat(p["DELTA_W"], p["DELTA_W"]) + rl
+    c["e"] = c["d2"] + mul_lat(p["DSQ_W"], p["SIXTH_W"]) + rl
+    c["de"] = c["e"] + mul_lat(p["DELTA_W"], p["DSQ_W"]) + rl
+    c["sd"] = c["de"] + rl
+    c["acc"] = c["sd"] + max(mul_lat(p["TAB_W"], p["DSQ_W"]), mul_lat(p["TAB_W"], p["DELTA_W"])) + rl
+    c["sc"] = c["acc"] + 2 + rl
+    c["LATENCY"] = c["sc"] + 2
+    return c
+
+
+# ---- sources -----------------------------------------------------------------------------------------
+DEPS = {
+    "ts_resize": [],
+    "ts_delay": [],
+    "ts_round_sat": [],
+    "ts_ecp5_mult18": [],
+    "ts_mul": ["ts_resize", "ts_delay", "ts_ecp5_mult18"],
+    "ts_quat_mul": ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
+    "ts_quat_rotate": ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
+    "ts_sincos": ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
+    "ts_joint_quat": ["ts_sincos", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
+    "ts_screw_transport": ["ts_quat_rotate", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
+}
+#: the datapath modules (documented, synthesised); the others are shared pieces
+PRIMITIVES = ("ts_quat_mul", "ts_quat_rotate", "ts_sincos", "ts_joint_quat", "ts_screw_transport")
+SHARED = ("ts_round_sat", "ts_mul", "ts_delay", "ts_resize")
+
+
+def sources(module: str, target: str = "GENERIC", sim_models: bool = True) -> list[str]:
+    """Verilog files of a module and everything it instantiates (closure of DEPS)."""
+    seen: list[str] = []
+
+    def add(m: str) -> None:
+        if m in seen:
+            return
+        seen.append(m)
+        for d in DEPS[m]:
+            add(d)
+
+    add(module)
+    files = [str(RTL / f"{m}.v") for m in seen]
+    if target == "ECP5" and "ts_ecp5_mult18" in seen and sim_models:
+        files.append(str(SIM_MODELS / "MULT18X18D.v"))
+    return files
+
+
+def module_params(module: str, cfg: str, target: str = "GENERIC", **kw) -> dict:
+    """Parameter set of a datapath module for a configuration (rotate: kind=..., inverse=...)."""
+    if module == "ts_quat_mul":
+        return quat_mul(cfg, target)
+    if module == "ts_quat_rotate":
+        return quat_rotate(cfg, kw.get("kind", "axis"), kw.get("inverse", False), target)
+    if module == "ts_sincos":
+        return sincos(cfg, target, kw.get("rom_path"))
+    if module == "ts_joint_quat":
+        return joint_quat(cfg, target, kw.get("rom_path"))
+    if module == "ts_screw_transport":
+        return screw_transport(cfg, target)
+    raise KeyError(module)
+
+
+# ---- parameter sets of the shared pieces (lint, benches) -------------------------------------------
+def mul_shapes(cfg: str) -> list[tuple[int, int]]:
+    """Operand widths of the multipliers of a configuration (distinct)."""
+    w = lambda n: fmt(cfg, n)[0]  # noqa: E731
+    r = w("turn_t") - 2 - int(formats(cfg)["TRIG_TABLE_BITS"])
+    cand = [(w("quat_t"), w("quat_t")), (w("angle_t"), w("kturn_t")), (r + 1, w("twopi_t")),
+            (w("dsq_t"), w("sixth_t")), (w("quat_t"), w("len_t")), (w("scale_t"), w("quat_t")),
+            (w("jw_t"), w("lever_t"))]
+    out = []
+    for c in cand:
+        if c not in out:
+            out.append(c)
+    return out
+
+
+def round_sat_sets(cfg: str) -> list[tuple[int, int, int, int]]:
+    """(IN_W, SHIFT, OUT_W, SAT) of eight ts_round_sat instances taken from the datapath of cfg, plus
+    left shifts (with and without possible saturation)."""
+    qw, qf = fmt(cfg, "quat_t")
+    tw, tf = fmt(cfg, "uvec_tmp_t")
+    dw, df = fmt(cfg, "delta_t")
+    sw, sf = fmt(cfg, "dsq_t")
+    aw, af = fmt(cfg, "angle_t")
+    kw, kf = fmt(cfg, "kturn_t")
+    uw, _ = fmt(cfg, "turn_t")
+    xw, xf = fmt(cfg, "twopi_t")
+    r = uw - 2 - int(formats(cfg)["TRIG_TABLE_BITS"])
+    return [
+        (2 * qw + 2, qf, qw, 1),                  # ts_quat_mul output
+        (2 * qw + 1, 2 * qf - 1 - tf, tw, 1),     # ts_quat_rotate t (axis)
+        (r + 1 + xw, uw + xf - df, dw, 1),        # ts_sincos d
+        (dw + 1, 0, dw, 1),                       # ts_sincos sd (saturation only)
+        (dw + sw, sf, dw, 1),                     # ts_sincos de (result narrower than the output)
+        (aw + kw, af + kf - uw, uw, 0),           # ts_joint_quat wrap to turn_t
+        (qw - 4, -3, qw, 1),                      # left shift with saturation
+        (qw - 4, -2, qw + 3, 1),                  # left shift, no saturation possible
+    ]
+
+
+def lint_jobs() -> list[tuple[str, list[str], dict]]:
+    """(top, files, parameters) of every module with every parameter set it is used with."""
+    jobs = []
+    for cfg in CONFIGS:
+        for target in TARGETS:
+            for m in PRIMITIVES:
+                kw = {"kind": "axis"} if m == "ts_quat_rotate" else {}
+                p = module_params(m, cfg, target, rom_path=str(rom_file(cfg)), **kw)
+                jobs.append((m, sources(m, target), p))
+            for kind in ROTATE_KINDS:
+                for inv in (False, True):
+                    if kind == "axis" and not inv:
+                        continue
+                    jobs.append(("ts_quat_rotate", sources("ts_quat_rotate", target), quat_rotate(cfg, kind, inv, target)))
+            for aw, bw in mul_shapes(cfg):
+                jobs.append(("ts_mul", sources("ts_mul", target), {"A_W": aw, "B_W": bw, "TARGET": target}))
+        for iw, sh, ow, sa in round_sat_sets(cfg):
+            jobs.append(("ts_round_sat", sources("ts_round_sat"), {"IN_W": iw, "SHIFT": sh, "OUT_W": ow, "SAT": sa}))
+    for w, d in ((1, 0), (1, 1), (8, 2), (81, 40)):
+        jobs.append(("ts_delay", sources("ts_delay"), {"W": w, "DEPTH": d}))
+    for iw, l, ow in ((8, 0, 12), (8, 0, 8), (12, 0, 8), (8, 3, 14), (8, 3, 11), (8, 3, 9)):
+        jobs.append(("ts_resize", sources("ts_resize"), {"IN_W": iw, "LSH": l, "OUT_W": ow}))
+    jobs.append(("ts_ecp5_mult18", sources("ts_ecp5_mult18", "ECP5"), {}))
+    return jobs
+
+
+if __name__ == "__main__":
+    import sys
+    if sys.argv[1:] == ["lint-jobs"]:
+        # one line per job: top<TAB>files (space separated)<TAB>NAME=VALUE ... (strings in double quotes)
+        for top, files, p in lint_jobs():
+            ps = " ".join(f'{k}="{v}"' if isinstance(v, str) else f"{k}={v}" for k, v in p.items())
+            print(f"{top}\t{' '.join(files)}\t{ps}")
+    else:
+        sys.exit("usage: rtlparams.py lint-jobs")
