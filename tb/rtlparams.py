@@ -263,6 +263,10 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
     for iw, l, ow in ((8, 0, 12), (8, 0, 8), (12, 0, 8), (8, 3, 14), (8, 3, 11), (8, 3, 9)):
         jobs.append(("ts_resize", sources("ts_resize"), {"IN_W": iw, "LSH": l, "OUT_W": ow}))
     jobs.append(("ts_ecp5_mult18", sources("ts_ecp5_mult18", "ECP5"), {}))
+    # the generated register block (rtl/ts_servo_regs.rdl): joint counts at the extremes, both configurations
+    for nmax in (1, 8, 60):
+        for config in (0, 1):
+            jobs.append(("ts_servo_regs", [str(RTL / "ts_servo_regs.v")], {"NMAX": nmax, "CONFIG": config}))
     return jobs
 
 
