@@ -4,6 +4,8 @@
 #   make setup   Debian packages (if missing), .venv with pinned versions, the C++ model and bindings
 #   make bench   benchmark tables (docs/benchmarks.md)
 #   make golden  regenerate tb/golden/ from the model
+#   make synth   ECP5 / 7-series resources and post-route Fmax of the RTL (docs/resources.md)
+#   make lint    verilator -Wall and iverilog on every RTL parameter set; HLS kernel checks
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
@@ -24,10 +26,10 @@ PKG      := model/python/tensor_servo
 STAMP_APT  := $(BUILD)/.apt.stamp
 STAMP_VENV := $(VENV)/.stamp
 
-.PHONY: help setup build test test-cpp test-py demo bench golden lint clean distclean hls-csim hls-lint hls-tables regs regs-check regs-html
+.PHONY: help setup build test test-cpp test-py demo bench golden lint lint-rtl synth clean distclean hls-csim hls-lint hls-tables regs regs-check regs-html
 
 help:
-	@sed -n '2,7p' Makefile | sed 's/^# //'
+	@sed -n '2,8p' Makefile | sed 's/^# //'
 
 # ---- set-up ------------------------------------------------------------------------------------
 $(STAMP_APT): scripts/setup_system.sh
@@ -109,7 +111,14 @@ bench: setup
 golden: setup
 	$(VENV)/bin/tservo golden -o tb/golden
 
-lint: setup hls-lint
+lint: setup hls-lint lint-rtl
+
+lint-rtl: setup
+	PYTHON=$(PY) bash scripts/lint_rtl.sh -j $(JOBS)
+
+# Yosys synth_ecp5 + nextpnr-ecp5 (LFE5U-85F -6, 3 seeds) and synth_xilinx counts; ~10 min on 2 cores.
+synth: setup
+	$(PY) scripts/synth.py --jobs $(JOBS)
 
 # ---- register map (rtl/ts_servo_regs.rdl -> Verilog, C header, Python, docs) -------------------------
 regs: setup
