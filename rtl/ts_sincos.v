@@ -147,7 +147,7 @@ module ts_sincos #(
     .clk(clk), .rst(rst), .in_x(dsub), .out_y(sd), .out_sat(sat_sd));
 
   // ---- table: S, C of the index, read so that they arrive with sd -----------------------------
-  // A ROM in logic, read in two registered stages: 2^ROM_BANK_BITS banks indexed by the low index
+  // A ROM in logic, read in two registered stages: four banks indexed by the low index
   // bits, then the bank selected by the high bits.  (ECP5 EBR: yosys maps it without the output
   // register, whose 5.8 ns clock-to-output at speed grade 6 alone nearly fills a 150 MHz cycle.)
   // (T_BITS >= 3.)

@@ -18,7 +18,7 @@ N_RANDOM = int(os.environ.get("TS_NVEC", "10000"))
 
 def shapes(cfg):
     f = lambda n: rtlparams.fmt(cfg, n)[0]  # noqa: E731
-    r = f("turn_t") - 2 - 8
+    r = f("turn_t") - 2 - int(rtlparams.formats(cfg)["TRIG_TABLE_BITS"])
     used = [(f("quat_t"), f("quat_t")), (f("angle_t"), f("kturn_t")), (r + 1, f("twopi_t")),
             (f("dsq_t"), f("sixth_t"))]
     out = []
