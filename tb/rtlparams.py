@@ -163,6 +163,8 @@ DEPS = {
     "ts_joint_quat": ["ts_sincos", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
     "ts_screw_transport": ["ts_quat_rotate", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
 }
+DEPS["ts_core_fk"] = ["ts_joint_quat", "ts_sincos", "ts_quat_mul", "ts_quat_rotate", "ts_screw_transport", "ts_mul",
+                      "ts_resize", "ts_delay", "ts_round_sat"]
 #: the datapath modules (documented, synthesised); the others are shared pieces
 PRIMITIVES = ("ts_quat_mul", "ts_quat_rotate", "ts_sincos", "ts_joint_quat", "ts_screw_transport")
 SHARED = ("ts_round_sat", "ts_mul", "ts_delay", "ts_resize")
@@ -267,6 +269,11 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
     for nmax in (1, 8, 60):
         for config in (0, 1):
             jobs.append(("ts_servo_regs", [str(RTL / "ts_servo_regs.v")], {"NMAX": nmax, "CONFIG": config}))
+    # the FK/Jacobian engine (rtl/ts_core_fk.v): both configurations and multiplier targets
+    for config in (0, 1):
+        for target in TARGETS:
+            jobs.append(("ts_core_fk", sources("ts_core_fk", target),
+                         {"NMAX": 8, "CONFIG": config, "ROM_FILE": str(rom_file(CONFIGS[config])), "TARGET": target}))
     return jobs
 
 
