@@ -239,7 +239,7 @@ module ts_core_fk #(
   reg [JI_W:0]   d_cnt;      // prismatic displacements received
   reg [JI_W:0]   col_in;     // columns issued
   reg [JI_W:0]   col_out;    // columns received
-  reg have_qf, have_pf;
+  reg have_pf, have_q2;
 
   reg signed [Q_W-1:0] qc [0:3];   // Q_{i-1}
   reg signed [P_W-1:0] pc [0:2];   // p_{i-1}
@@ -414,8 +414,15 @@ module ts_core_fk #(
   endgenerate
 
   // ---- the sequencer ----------------------------------------------------------------------------------
-  wire qf_now = have_qf | qm_ovalid;
+  // pF (the position path, longer than the quaternion path) is waited for only where it is used:
+  // the end of the joint's step, the tool, the prismatic origin
   wire pf_now = have_pf | add_valid;
+  wire signed [P_W-1:0] pf_cur [0:2];
+  generate
+    for (gi = 0; gi < 3; gi = gi + 1) begin : g_pfc
+      assign pf_cur[gi] = add_valid ? add_o[gi] : pf[gi];
+    end
+  endgenerate
   wire last_col_in = (col_in[JI_W-1:0] == n_m1);
 
   always @(posedge clk) begin
@@ -428,8 +435,8 @@ module ts_core_fk #(
       d_cnt <= {(JI_W+1){1'b0}};
       col_in <= {(JI_W+1){1'b0}};
       col_out <= {(JI_W+1){1'b0}};
-      have_qf <= 1'b0;
       have_pf <= 1'b0;
+      have_q2 <= 1'b0;
       qm_valid <= 1'b0;
       ro_valid <= 1'b0;
       st_valid <= 1'b0;
@@ -486,6 +493,11 @@ module ts_core_fk #(
       if (add_valid && (ro_sat_d || (|add_sat))) out_sat <= 1'b1;
       if (st_ovalid && st_sat) out_sat <= 1'b1;
       if (pp_ovalid && (|pp_sat)) out_sat <= 1'b1;
+      // pF of the current step, whatever the state
+      if (add_valid) begin
+        have_pf <= 1'b1;
+        for (k = 0; k < 3; k = k + 1) pf[k] <= add_o[k];
+      end
 
       case (state)
         S_IDLE: begin
@@ -511,28 +523,25 @@ module ts_core_fk #(
             qm_b[k] <= tool ? c_qt[k] : c_qo[{ji, k[1:0]}];
           end
           for (k = 0; k < 3; k = k + 1) ro_v[k] <= tool ? c_pt[k] : c_po[{ji, k[1:0]}];
-          have_qf <= 1'b0;
           have_pf <= 1'b0;
+          have_q2 <= 1'b0;
           state <= S_WAIT1;
         end
         S_WAIT1: begin
           if (qm_ovalid) begin
-            have_qf <= 1'b1;
             for (k = 0; k < 4; k = k + 1) qf[k] <= qm_o[k];
+            state <= S_NEXT;
           end
-          if (add_valid) begin
-            have_pf <= 1'b1;
-            for (k = 0; k < 3; k = k + 1) pf[k] <= add_o[k];
-          end
-          if (qf_now && pf_now) state <= S_NEXT;
         end
         S_NEXT: begin
           if (tool) begin
-            out_tool_q_w <= qf[0]; out_tool_q_x <= qf[1]; out_tool_q_y <= qf[2]; out_tool_q_z <= qf[3];
-            out_tool_p_x <= pf[0]; out_tool_p_y <= pf[1]; out_tool_p_z <= pf[2];
-            col_in <= {(JI_W+1){1'b0}};
-            col_out <= {(JI_W+1){1'b0}};
-            state <= (c_n == {(JI_W+1){1'b0}}) ? S_DONE : S_JAC;
+            if (pf_now) begin
+              out_tool_q_w <= qf[0]; out_tool_q_x <= qf[1]; out_tool_q_y <= qf[2]; out_tool_q_z <= qf[3];
+              out_tool_p_x <= pf_cur[0]; out_tool_p_y <= pf_cur[1]; out_tool_p_z <= pf_cur[2];
+              col_in <= {(JI_W+1){1'b0}};
+              col_out <= {(JI_W+1){1'b0}};
+              state <= (c_n == {(JI_W+1){1'b0}}) ? S_DONE : S_JAC;
+            end
           end else if (!c_pr[ji]) begin
             // revolute: Q_i = QF (x) Qj_i once the joint quaternion is there
             if (jq_cnt > {1'b0, ji}) begin
@@ -554,14 +563,16 @@ module ts_core_fk #(
           end
         end
         S_WAIT2: begin
+          // Q_i (kept in qc: Q_{i-1} is not needed any more) and pF
           if (qm_ovalid) begin
-            for (k = 0; k < 4; k = k + 1) begin
-              qc[k] <= qm_o[k];
-              r_qf[{ji, k[1:0]}] <= qf[k];
-            end
+            have_q2 <= 1'b1;
+            for (k = 0; k < 4; k = k + 1) qc[k] <= qm_o[k];
+          end
+          if ((have_q2 || qm_ovalid) && pf_now) begin
+            for (k = 0; k < 4; k = k + 1) r_qf[{ji, k[1:0]}] <= qf[k];
             for (k = 0; k < 3; k = k + 1) begin
-              pc[k] <= pf[k];
-              r_p[{ji, k[1:0]}] <= pf[k];
+              pc[k] <= pf_cur[k];
+              r_p[{ji, k[1:0]}] <= pf_cur[k];
             end
             if ({1'b0, ji} == c_n - 1'b1) tool <= 1'b1;
             else ji <= ji + 1'b1;
@@ -576,8 +587,10 @@ module ts_core_fk #(
           end
         end
         S_PP: begin
-          pp_valid <= 1'b1;
-          state <= S_WAITP;
+          if (have_pf) begin
+            pp_valid <= 1'b1;
+            state <= S_WAITP;
+          end
         end
         S_WAITP: begin
           if (pp_ovalid) begin
