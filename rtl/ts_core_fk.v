@@ -178,52 +178,62 @@ module ts_core_fk #(
   wire            cg = in_cfg_addr[JI_W+4];
   wire unused_cfg_data = ^in_cfg_data;
 
+  wire cfg_wr = in_cfg_we && !out_busy;
+  wire q_wr = in_q_we && !out_busy;
+
+  // Per-joint registers, one block per entry (the lint tool does not unroll a reset loop over
+  // the whole array at large NMAX).
+  generate
+    for (gi = 0; gi < AD; gi = gi + 1) begin : g_jcfg
+      localparam [JI_W-1:0] J = gi;
+      always @(posedge clk) begin
+        if (rst) begin
+          for (k = 0; k < 4; k = k + 1) begin
+            c_qo[4*gi+k] <= {Q_W{1'b0}};
+            c_po[4*gi+k] <= {LN_W{1'b0}};
+            c_ax[4*gi+k] <= {Q_W{1'b0}};
+          end
+          c_s[gi] <= {S_W{1'b0}};
+          c_k[gi] <= {KT_W{1'b0}};
+          c_pr[gi] <= 1'b0;
+          c_q[gi] <= {ANG_W{1'b0}};
+        end else begin
+          if (cfg_wr && !cg && (cj == J)) begin
+            for (k = 0; k < 4; k = k + 1) begin
+              if ((cf[3:2] == 2'd0) && (cf[1:0] == k[1:0])) c_qo[4*gi+k] <= in_cfg_data[Q_W-1:0];
+              if ((cf[3:2] == 2'd1) && (cf[1:0] == k[1:0])) c_po[4*gi+k] <= in_cfg_data[LN_W-1:0];
+              if ((cf[3:2] == 2'd2) && (cf[1:0] == k[1:0])) c_ax[4*gi+k] <= in_cfg_data[Q_W-1:0];
+            end
+            if (cf == 4'd12) c_s[gi] <= in_cfg_data[S_W-1:0];
+            if (cf == 4'd13) c_k[gi] <= in_cfg_data[KT_W-1:0];
+            if (cf == 4'd14) c_pr[gi] <= in_cfg_data[0];
+          end
+          if (q_wr && (in_q_addr == J)) c_q[gi] <= in_q_data;
+        end
+      end
+    end
+  endgenerate
+
+  // base, tool, joint count
   always @(posedge clk) begin
     if (rst) begin
-      for (k = 0; k < 4 * AD; k = k + 1) begin
-        c_qo[k] <= {Q_W{1'b0}};
-        c_po[k] <= {LN_W{1'b0}};
-        c_ax[k] <= {Q_W{1'b0}};
-      end
-      for (k = 0; k < AD; k = k + 1) begin
-        c_s[k] <= {S_W{1'b0}};
-        c_k[k] <= {KT_W{1'b0}};
-        c_q[k] <= {ANG_W{1'b0}};
-      end
       for (k = 0; k < 4; k = k + 1) begin
         c_qb[k] <= {Q_W{1'b0}};
         c_pb[k] <= {LN_W{1'b0}};
         c_qt[k] <= {Q_W{1'b0}};
         c_pt[k] <= {LN_W{1'b0}};
       end
-      c_pr <= {AD{1'b0}};
       c_n <= {(JI_W+1){1'b0}};
-    end else begin
-      if (in_cfg_we && !out_busy) begin
-        if (!cg) begin
-          case (cf[3:2])
-            2'd0: c_qo[{cj, cf[1:0]}] <= in_cfg_data[Q_W-1:0];
-            2'd1: c_po[{cj, cf[1:0]}] <= in_cfg_data[LN_W-1:0];
-            2'd2: c_ax[{cj, cf[1:0]}] <= in_cfg_data[Q_W-1:0];
-            default: begin
-              if (cf[1:0] == 2'd0) c_s[cj] <= in_cfg_data[S_W-1:0];
-              if (cf[1:0] == 2'd1) c_k[cj] <= in_cfg_data[KT_W-1:0];
-              if (cf[1:0] == 2'd2) c_pr[cj] <= in_cfg_data[0];
-            end
-          endcase
-        end else begin
-          case (cf[3:2])
-            2'd0: c_qb[cf[1:0]] <= in_cfg_data[Q_W-1:0];
-            2'd1: c_pb[cf[1:0]] <= in_cfg_data[LN_W-1:0];
-            2'd2: c_qt[cf[1:0]] <= in_cfg_data[Q_W-1:0];
-            default: begin
-              if (cf[1:0] == 2'd3) c_n <= in_cfg_data[JI_W:0];
-              else c_pt[cf[1:0]] <= in_cfg_data[LN_W-1:0];
-            end
-          endcase
+    end else if (cfg_wr && cg) begin
+      case (cf[3:2])
+        2'd0: c_qb[cf[1:0]] <= in_cfg_data[Q_W-1:0];
+        2'd1: c_pb[cf[1:0]] <= in_cfg_data[LN_W-1:0];
+        2'd2: c_qt[cf[1:0]] <= in_cfg_data[Q_W-1:0];
+        default: begin
+          if (cf[1:0] == 2'd3) c_n <= in_cfg_data[JI_W:0];
+          else c_pt[cf[1:0]] <= in_cfg_data[LN_W-1:0];
         end
-      end
-      if (in_q_we && !out_busy) c_q[in_q_addr] <= in_q_data;
+      endcase
     end
   end
 
@@ -461,14 +471,6 @@ module ts_core_fk #(
         zr[k] <= {Q_W{1'b0}};
         ro_v[k] <= {LN_W{1'b0}};
       end
-      for (k = 0; k < 4 * AD; k = k + 1) begin
-        r_jq[k] <= {Q_W{1'b0}};
-        r_qf[k] <= {Q_W{1'b0}};
-        r_p[k] <= {P_W{1'b0}};
-        r_w[k] <= {JW_W{1'b0}};
-        r_v[k] <= {JV_W{1'b0}};
-      end
-      for (k = 0; k < AD; k = k + 1) r_d[k] <= {L_W{1'b0}};
     end else begin
       qm_valid <= 1'b0;
       ro_valid <= 1'b0;
@@ -479,12 +481,10 @@ module ts_core_fk #(
       // joint quaternion and d streams (issued from the start on, received whatever the state)
       if (pre_valid) pre_in <= pre_in + 1'b1;
       if (jq_valid) begin
-        for (k = 0; k < 4; k = k + 1) r_jq[{jq_j, k[1:0]}] <= jq_o[k];
         jq_cnt <= jq_cnt + 1'b1;
         if (jq_sat && !c_pr[jq_j]) out_sat <= 1'b1;
       end
       if (d_valid) begin
-        r_d[d_j] <= d_o;
         d_cnt <= d_cnt + 1'b1;
         if (d_sat && c_pr[d_j]) out_sat <= 1'b1;
       end
@@ -569,11 +569,7 @@ module ts_core_fk #(
             for (k = 0; k < 4; k = k + 1) qc[k] <= qm_o[k];
           end
           if ((have_q2 || qm_ovalid) && pf_now) begin
-            for (k = 0; k < 4; k = k + 1) r_qf[{ji, k[1:0]}] <= qf[k];
-            for (k = 0; k < 3; k = k + 1) begin
-              pc[k] <= pf_cur[k];
-              r_p[{ji, k[1:0]}] <= pf_cur[k];
-            end
+            for (k = 0; k < 3; k = k + 1) pc[k] <= pf_cur[k];
             if ({1'b0, ji} == c_n - 1'b1) tool <= 1'b1;
             else ji <= ji + 1'b1;
             state <= S_ORIG;
@@ -594,14 +590,8 @@ module ts_core_fk #(
         end
         S_WAITP: begin
           if (pp_ovalid) begin
-            for (k = 0; k < 4; k = k + 1) begin
-              qc[k] <= qf[k];
-              r_qf[{ji, k[1:0]}] <= qf[k];
-            end
-            for (k = 0; k < 3; k = k + 1) begin
-              pc[k] <= pp_o[k];
-              r_p[{ji, k[1:0]}] <= pp_o[k];
-            end
+            for (k = 0; k < 4; k = k + 1) qc[k] <= qf[k];
+            for (k = 0; k < 3; k = k + 1) pc[k] <= pp_o[k];
             if ({1'b0, ji} == c_n - 1'b1) tool <= 1'b1;
             else ji <= ji + 1'b1;
             state <= S_ORIG;
@@ -629,15 +619,46 @@ module ts_core_fk #(
       endcase
 
       // columns (the screw transport's Jacobian use)
-      if (st_ovalid && (state == S_JAC || state == S_JWAIT)) begin
-        for (k = 0; k < 3; k = k + 1) begin
-          r_w[{col_out[JI_W-1:0], k[1:0]}] <= st_w[k];
-          r_v[{col_out[JI_W-1:0], k[1:0]}] <= st_v[k];
-        end
-        col_out <= col_out + 1'b1;
-      end
+      if (col_we) col_out <= col_out + 1'b1;
     end
   end
+
+  // ---- per-joint results, one block per entry -------------------------------------------------------
+  // frame i stored at the end of its step: QF_i, and p_i (pF, or the prismatic origin)
+  wire fr_we = ((state == S_WAIT2) && (have_q2 || qm_ovalid) && pf_now) || ((state == S_WAITP) && pp_ovalid);
+  wire col_we = st_ovalid && ((state == S_JAC) || (state == S_JWAIT));
+  wire [JI_W-1:0] col_j = col_out[JI_W-1:0];
+  generate
+    for (gi = 0; gi < AD; gi = gi + 1) begin : g_res
+      localparam [JI_W-1:0] J = gi;
+      always @(posedge clk) begin
+        if (rst) begin
+          for (k = 0; k < 4; k = k + 1) begin
+            r_jq[4*gi+k] <= {Q_W{1'b0}};
+            r_qf[4*gi+k] <= {Q_W{1'b0}};
+            r_p[4*gi+k] <= {P_W{1'b0}};
+            r_w[4*gi+k] <= {JW_W{1'b0}};
+            r_v[4*gi+k] <= {JV_W{1'b0}};
+          end
+          r_d[gi] <= {L_W{1'b0}};
+        end else begin
+          if (jq_valid && (jq_j == J))
+            for (k = 0; k < 4; k = k + 1) r_jq[4*gi+k] <= jq_o[k];
+          if (d_valid && (d_j == J)) r_d[gi] <= d_o;
+          if (fr_we && (ji == J)) begin
+            for (k = 0; k < 4; k = k + 1) r_qf[4*gi+k] <= qf[k];
+            for (k = 0; k < 3; k = k + 1) r_p[4*gi+k] <= (state == S_WAITP) ? pp_o[k] : pf_cur[k];
+          end
+          if (col_we && (col_j == J)) begin
+            for (k = 0; k < 3; k = k + 1) begin
+              r_w[4*gi+k] <= st_w[k];
+              r_v[4*gi+k] <= st_v[k];
+            end
+          end
+        end
+      end
+    end
+  endgenerate
 
   // ---- column read port -----------------------------------------------------------------------------
   always @(posedge clk) begin

@@ -274,6 +274,9 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
         for target in TARGETS:
             jobs.append(("ts_core_fk", sources("ts_core_fk", target),
                          {"NMAX": 8, "CONFIG": config, "ROM_FILE": str(rom_file(CONFIGS[config])), "TARGET": target}))
+        for nmax in (1, 64):
+            jobs.append(("ts_core_fk", sources("ts_core_fk"),
+                         {"NMAX": nmax, "CONFIG": config, "ROM_FILE": str(rom_file(CONFIGS[config])), "TARGET": "GENERIC"}))
     return jobs
 
 
