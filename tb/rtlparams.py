@@ -166,6 +166,7 @@ DEPS = {
 DEPS["ts_core_fk"] = ["ts_joint_quat", "ts_sincos", "ts_quat_mul", "ts_quat_rotate", "ts_screw_transport", "ts_mul",
                       "ts_resize", "ts_delay", "ts_round_sat"]
 DEPS["ts_core_commit"] = ["ts_mul", "ts_resize", "ts_delay", "ts_ecp5_mult18"]
+DEPS["ts_core_solve"] = ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat", "ts_ecp5_mult18"]
 #: the datapath modules (documented, synthesised); the others are shared pieces
 PRIMITIVES = ("ts_quat_mul", "ts_quat_rotate", "ts_sincos", "ts_joint_quat", "ts_screw_transport")
 SHARED = ("ts_round_sat", "ts_mul", "ts_delay", "ts_resize")
@@ -284,6 +285,13 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
             for nmax in (1, 8, 60):
                 jobs.append(("ts_core_commit", sources("ts_core_commit", target),
                              {"NMAX": nmax, "CONFIG": config, "TARGET": target}))
+    # the solver / integration engine (rtl/ts_core_solve.v): both configurations and multiplier targets
+    for config in (0, 1):
+        for target in TARGETS:
+            for nmax in (1, 8, 60):
+                jobs.append(("ts_core_solve", sources("ts_core_solve", target),
+                             {"NMAX": nmax, "CONFIG": config, "TARGET": target,
+                              "ROM_FILE": str(RTL / f"ts_recip_rom_{CONFIGS[config]}.mem")}))
     return jobs
 
 

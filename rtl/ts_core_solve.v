@@ -1,0 +1,882 @@
+// SPDX-License-Identifier: Apache-2.0
+// tensor-servo: the back half of the servo tick (one task), bit-exact with the model's
+// ts::servo_back (model/include/tensor_servo/servo.hpp) and the division-free coordinate-descent
+// solver (solver.hpp: solver_target, solver_columns, solver_steps, warm_leak, solver_run):
+//   vs    = (cvt<tw_t>(L V_w); cvt<tw_t>(V_v))                 scaled target
+//   Js_i  = (cvt<jsc_t>(L w_i); cvt<jsc_t>(v_i))                scaled columns
+//   d_i   = |Js_i|^2 (exact), k_i = floor(log2 d_i), m_i = d_i 2^-k_i (truncated to mant_t)
+//   y0    = ROM[6 fraction bits of m_i], e = cvt(1 - m y0), y = cvt(y0 + y0 e), c_i = cvt(mu_i y)
+//   bounds: [-vmax, vmax], position bounds klim (lo - q), klim (hi - q) clamped into it
+//   q'    = clamp(warm - (warm >> leak)),  racc = Vs - sum Js_i q'_i (exact, tacc_t)
+//   sweeps x joints: g = <Js_i, cvt<tw_t>(racc)>, gk = cvt_shr<gk_t>(g, k_i),
+//                    qn = clamp(cvt(q'_i + gk c_i)), dq = cvt(qn - q'_i), racc -= Js_i dq
+//   r = cvt<tw_t>(racc), flags (limit / velocity limit active), q_next = clamp(cvt(q + q' dt))
+// One shared registered multiplier (ts_mul) under a sequencer; the six-row products (columns,
+// |Js_i|^2, <Js_i, r>, residual updates) are issued one per cycle, everything else waits for its
+// result.  Every narrowing is a ts_round_sat (the model's cvt: AP_RND + AP_SAT with the flag).
+//
+// Configuration (raw words of the model's formats in the low bits of in_cfg_data; write while
+// idle): address {global, joint[JI_W-1:0], field[3:0]}
+//   global = 0, joint j: field 0 lo (angle_t), 1 hi (angle_t), 2 vmax (qd_t), 3 mu (mu_t),
+//                        4 bit 0: limited
+//   global = 1:          field 0 L (lchar_t), 1 klim (klim_t), 2 dt (dt_t), 3 sweeps (unsigned,
+//                        SW_W bits), 4 warm_leak (shift 0..31)
+// Per-solve inputs (in_x_we / in_x_addr / in_x_data, same address layout):
+//   global = 0, joint j: field 0-2 J omega rows x y z (jw_t), 3-5 J v rows (jv_t),
+//                        6 q (angle_t), 7 warm start q'_warm (qd_t)
+//   global = 1:          field 0-5 V (omega x y z: vel_t; v x y z: vel_t)
+// in_start (while idle) with in_n (1..NMAX joints) runs one solve: out_busy until out_done (one
+// cycle pulse); then out_qd (qd_t per joint), out_q_next (angle_t), out_r (tw_t, rows omega; v)
+// and out_flags (the model's Status bits: 0 ST_OVF_ANGLE, 8 ST_OVF_SOLVER, 16 ST_LIMIT_ACTIVE,
+// 17 ST_VLIMIT_ACTIVE) hold until the next start.  Joint j of a flat bus: bits [j*W +: W].
+// Widths: every *_W parameter below is derived from CONFIG (0 default, 1 compact); do not override.
+// Language: Verilog 2005
+`resetall
+`timescale 1ns / 1ps
+`default_nettype none
+
+module ts_core_solve #(
+  // Largest joint count
+  parameter NMAX = 8,
+  // Number configuration: 0 default, 1 compact
+  parameter CONFIG = 0,
+  // Reciprocal seed table memory file (rtl/ts_recip_rom_<config>.mem)
+  parameter ROM_FILE = "ts_recip_rom_default.mem",
+  // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
+  parameter TARGET = "GENERIC",
+  // Sweep count width
+  parameter SW_W = 16,
+  // Joint index width: derived from NMAX, do not override
+  parameter JI_W = (NMAX > 1) ? $clog2(NMAX) : 1,
+  // Width of angle_t: derived from CONFIG, do not override
+  parameter ANG_W = (CONFIG == 0) ? 32 : 18,
+  // Width of qd_t: derived from CONFIG, do not override
+  parameter QD_W = (CONFIG == 0) ? 27 : 18,
+  // Width of tw_t: derived from CONFIG, do not override
+  parameter TW_W = (CONFIG == 0) ? 27 : 18,
+  // Data bus width of both write ports (widest format of the configuration): derived, do not override
+  parameter CD_W = (CONFIG == 0) ? 32 : 18
+) (
+  input  wire                      clk,
+  input  wire                      rst,
+  // configuration write port
+  input  wire                      in_cfg_we,
+  input  wire [JI_W+4:0]           in_cfg_addr,
+  input  wire [CD_W-1:0]           in_cfg_data,
+  // per-solve inputs (J, V, q, warm start)
+  input  wire                      in_x_we,
+  input  wire [JI_W+4:0]           in_x_addr,
+  input  wire [CD_W-1:0]           in_x_data,
+  // control
+  input  wire                      in_start,
+  input  wire [JI_W:0]             in_n,
+  output reg                       out_busy,
+  output reg                       out_done,
+  // results
+  output wire [NMAX*QD_W-1:0]      out_qd,
+  output wire [NMAX*ANG_W-1:0]     out_q_next,
+  output reg  [6*TW_W-1:0]         out_r,
+  output reg  [31:0]               out_flags
+);
+
+  `include "ts_common.vh"
+
+  // ---- formats of the model (tensor_servo._model.formats; tb/ts_core_solve checks them) -------
+  localparam TS_ANGLE_W = (CONFIG == 0) ? 32 : 18;
+  localparam TS_ANGLE_F = (CONFIG == 0) ? 28 : 14;
+  localparam TS_JW_W = (CONFIG == 0) ? 27 : 18;
+  localparam TS_JW_F = (CONFIG == 0) ? 24 : 15;
+  localparam TS_JV_W = (CONFIG == 0) ? 27 : 18;
+  localparam TS_JV_F = (CONFIG == 0) ? 22 : 14;
+  localparam TS_VEL_W = (CONFIG == 0) ? 27 : 18;
+  localparam TS_VEL_F = (CONFIG == 0) ? 21 : 12;
+  localparam TS_LCHAR_W = (CONFIG == 0) ? 18 : 18;
+  localparam TS_LCHAR_F = (CONFIG == 0) ? 15 : 15;
+  localparam TS_JSC_W = (CONFIG == 0) ? 27 : 18;
+  localparam TS_JSC_F = (CONFIG == 0) ? 22 : 13;
+  localparam TS_TW_W = (CONFIG == 0) ? 27 : 18;
+  localparam TS_TW_F = (CONFIG == 0) ? 21 : 12;
+  localparam TS_QD_W = (CONFIG == 0) ? 27 : 18;
+  localparam TS_QD_F = (CONFIG == 0) ? 21 : 12;
+  localparam TS_GK_W = (CONFIG == 0) ? 27 : 18;
+  localparam TS_GK_F = (CONFIG == 0) ? 20 : 11;
+  localparam TS_MANT_W = (CONFIG == 0) ? 18 : 18;
+  localparam TS_MANT_F = (CONFIG == 0) ? 16 : 16;
+  localparam TS_RECIP_W = (CONFIG == 0) ? 18 : 18;
+  localparam TS_RECIP_F = (CONFIG == 0) ? 16 : 16;
+  localparam TS_MU_W = (CONFIG == 0) ? 18 : 18;
+  localparam TS_MU_F = (CONFIG == 0) ? 16 : 16;
+  localparam TS_STEP_W = (CONFIG == 0) ? 18 : 18;
+  localparam TS_STEP_F = (CONFIG == 0) ? 16 : 16;
+  localparam TS_KLIM_W = (CONFIG == 0) ? 27 : 18;
+  localparam TS_KLIM_F = (CONFIG == 0) ? 12 : 3;
+  localparam TS_QDIFF_W = (CONFIG == 0) ? 33 : 18;
+  localparam TS_QDIFF_F = (CONFIG == 0) ? 28 : 13;
+  localparam TS_DT_W = (CONFIG == 0) ? 32 : 18;
+  localparam TS_DT_F = (CONFIG == 0) ? 35 : 21;
+  localparam TS_TACC_W = (CONFIG == 0) ? 60 : 42;
+  localparam TS_TACC_F = (CONFIG == 0) ? 43 : 25;
+  localparam TS_RECIP_TABLE_BITS = (CONFIG == 0) ? 6 : 6;
+
+  localparam T = TS_RECIP_TABLE_BITS;
+  localparam AF = TS_ANGLE_F;
+  localparam JWW = TS_JW_W;
+  localparam JVW = TS_JV_W;
+  localparam VLW = TS_VEL_W;
+  localparam LCW = TS_LCHAR_W;
+  localparam JSW = TS_JSC_W;
+  localparam JSF = TS_JSC_F;
+  localparam QDF = TS_QD_F;
+  localparam TWF = TS_TW_F;
+  localparam GKW = TS_GK_W;
+  localparam GKF = TS_GK_F;
+  localparam MNW = TS_MANT_W;
+  localparam MNF = TS_MANT_F;
+  localparam RCW = TS_RECIP_W;
+  localparam RCF = TS_RECIP_F;
+  localparam MUW = TS_MU_W;
+  localparam STW = TS_STEP_W;
+  localparam KLW = TS_KLIM_W;
+  localparam QFW = TS_QDIFF_W;
+  localparam DTW = TS_DT_W;
+  localparam TAW = TS_TACC_W;
+  localparam TAF = TS_TACC_F;
+  localparam RL = ts_round_lat(1);
+
+  // e_t = num<recip_t::W, recip_t::I - T>
+  localparam EW = RCW;
+  localparam EF = RCF + T;
+  // |Js_i|^2 and <Js_i, r>: exact sums of six products, 5 more integer bits than one product
+  localparam DPF = 2 * JSF;
+  localparam DW = 2 * JSW + 5;
+  localparam GPF = JSF + TWF;
+  localparam GW = JSW + TW_W + 5;
+  localparam ACW = ts_max(DW, GW);
+  localparam KW = 8;
+  // shared multiplier: a in {L, Js, m, y0, mu, klim, gk, q'}, b in {jw, vel, Js, y0, e, y, qdiff,
+  // q'/dq, ro, c, dt}
+  localparam MAW = ts_max(ts_max(ts_max(LCW, JSW), ts_max(MNW, RCW)), ts_max(ts_max(MUW, KLW), ts_max(GKW, QD_W)));
+  localparam MBW = ts_max(ts_max(ts_max(JWW, VLW), ts_max(JSW, EW)), ts_max(ts_max(QFW, QD_W), ts_max(TW_W, ts_max(STW, DTW))));
+  localparam PW = MAW + MBW;
+  localparam MLAT = ts_mul_lat(MAW, MBW);
+  // klim (limit - q)
+  localparam PLW = KLW + QFW;
+  localparam PLF = TS_KLIM_F + TS_QDIFF_F;
+  localparam CMW = ts_max(PLW, QD_W + PLF - QDF) + 1;
+  // racc - Js_i dq (exact) before cvt<tacc_t>
+  localparam RPF = JSF + QDF;
+  localparam RSF = ts_max(TAF, RPF);
+  localparam RIW = ts_max(TAW - TAF, JSW + QD_W - RPF) + 1 + RSF;
+  // q' + gk c before cvt<qd_t>
+  localparam QPF = GKF + TS_STEP_F;
+  localparam QSF = ts_max(QDF, QPF);
+  localparam QIW = ts_max(QD_W - QDF, GKW + STW - QPF) + 1 + QSF;
+  // q + q' dt before cvt<angle_t>
+  localparam NPF = QDF + TS_DT_F;
+  localparam NSF = ts_max(AF, NPF);
+  localparam NIW = ts_max(ANG_W - AF, QD_W + DTW - NPF) + 1 + NSF;
+  // 1 - m y0 and y0 + y0 e
+  localparam EIW = MNW + RCW + 1;
+  localparam YIW = RCW + ts_max(EF, EW) + 1;
+  // cvt_shr<gk_t>(g, k): right shift s = GPF + k - GKF, k >= -DPF; left-aligned by GLS so the
+  // variable shift t = s + GLS is never negative
+  localparam GS_MIN = GPF - DPF - GKF;
+  localparam GLS = (GS_MIN < 0) ? -GS_MIN : 0;
+  localparam GXW = GW + GLS + 1;
+  localparam TOFF = GPF - GKF + GLS;
+  localparam [9:0] TOFF10 = TOFF;
+  localparam [KW-1:0] DPF_K = DPF;
+  localparam [7:0] ML8 = MLAT[7:0];
+
+  generate
+    if ((ANG_W != TS_ANGLE_W) || (QD_W != TS_QD_W) || (TW_W != TS_TW_W)) begin : g_bad_width
+      // Elaboration error: a port width parameter was overridden.
+      ts_core_solve_port_width_parameters_must_not_be_overridden u_error ();
+    end
+  endgenerate
+
+  // ---- storage ---------------------------------------------------------------------------------
+  // configuration
+  reg signed [ANG_W-1:0] cfg_lo    [0:NMAX-1];
+  reg signed [ANG_W-1:0] cfg_hi    [0:NMAX-1];
+  reg signed [QD_W-1:0]  cfg_vmax  [0:NMAX-1];
+  reg signed [MUW-1:0]   cfg_mu    [0:NMAX-1];
+  reg                    cfg_lim   [0:NMAX-1];
+  reg signed [LCW-1:0]   cfg_L;
+  reg signed [KLW-1:0]   cfg_klim;
+  reg signed [DTW-1:0]   cfg_dt;
+  reg [SW_W-1:0]         cfg_sweeps;
+  reg [4:0]              cfg_leak;
+  // per-solve inputs: J rows (omega at {j, 0..2}, v at {j, 4..6}), q, warm start, V
+  reg signed [JWW-1:0]   x_jw      [0:(4 << JI_W)-1];   // {joint, row}; not reset (RAM)
+  reg signed [JVW-1:0]   x_jv      [0:(4 << JI_W)-1];
+  reg signed [ANG_W-1:0] x_q       [0:NMAX-1];
+  reg signed [QD_W-1:0]  x_warm    [0:NMAX-1];
+  reg signed [VLW-1:0]   x_vw      [0:3];
+  reg signed [VLW-1:0]   x_vv      [0:3];
+  // solver state
+  reg signed [JSW-1:0]   js        [0:(8 << JI_W)-1];   // {joint, row}; not reset (RAM)
+  reg signed [TW_W-1:0]  vs        [0:5];
+  reg signed [STW-1:0]   cst       [0:NMAX-1];
+  reg signed [KW-1:0]    kst       [0:NMAX-1];
+  reg signed [QD_W-1:0]  blo       [0:NMAX-1];
+  reg signed [QD_W-1:0]  bhi       [0:NMAX-1];
+  reg                    blo_pos   [0:NMAX-1];
+  reg                    bhi_pos   [0:NMAX-1];
+  reg signed [QD_W-1:0]  qd        [0:NMAX-1];
+  reg signed [ANG_W-1:0] qnext     [0:NMAX-1];
+  reg signed [TAW-1:0]   racc      [0:5];
+
+  // ---- configuration and input write ports ------------------------------------------------------
+  wire            cfg_g = in_cfg_addr[JI_W+4];
+  wire [JI_W-1:0] cfg_j = in_cfg_addr[JI_W+3:4];
+  wire [3:0]      cfg_f = in_cfg_addr[3:0];
+  wire            x_g = in_x_addr[JI_W+4];
+  wire [JI_W-1:0] x_j = in_x_addr[JI_W+3:4];
+  wire [3:0]      x_f = in_x_addr[3:0];
+  wire [1:0]      x_f3 = x_f[1:0] - 2'd3;   // v row of fields 3-5 (self-determined 2-bit index)
+  integer ci, xi, ri;
+
+  always @(posedge clk) begin
+    if (rst) begin
+      for (ci = 0; ci < NMAX; ci = ci + 1) begin
+        cfg_lo[ci] <= {ANG_W{1'b0}};
+        cfg_hi[ci] <= {ANG_W{1'b0}};
+        cfg_vmax[ci] <= {QD_W{1'b0}};
+        cfg_mu[ci] <= {MUW{1'b0}};
+        cfg_lim[ci] <= 1'b0;
+      end
+      cfg_L <= {LCW{1'b0}};
+      cfg_klim <= {KLW{1'b0}};
+      cfg_dt <= {DTW{1'b0}};
+      cfg_sweeps <= {SW_W{1'b0}};
+      cfg_leak <= 5'd0;
+    end else if (in_cfg_we) begin
+      if (!cfg_g) begin
+        case (cfg_f)
+          4'd0: cfg_lo[cfg_j] <= in_cfg_data[ANG_W-1:0];
+          4'd1: cfg_hi[cfg_j] <= in_cfg_data[ANG_W-1:0];
+          4'd2: cfg_vmax[cfg_j] <= in_cfg_data[QD_W-1:0];
+          4'd3: cfg_mu[cfg_j] <= in_cfg_data[MUW-1:0];
+          4'd4: cfg_lim[cfg_j] <= in_cfg_data[0];
+          default: ;
+        endcase
+      end else begin
+        case (cfg_f)
+          4'd0: cfg_L <= in_cfg_data[LCW-1:0];
+          4'd1: cfg_klim <= in_cfg_data[KLW-1:0];
+          4'd2: cfg_dt <= in_cfg_data[DTW-1:0];
+          4'd3: cfg_sweeps <= in_cfg_data[SW_W-1:0];
+          4'd4: cfg_leak <= in_cfg_data[4:0];
+          default: ;
+        endcase
+      end
+    end
+  end
+
+  always @(posedge clk) begin
+    if (rst) begin
+      for (xi = 0; xi < NMAX; xi = xi + 1) begin
+        x_q[xi] <= {ANG_W{1'b0}};
+        x_warm[xi] <= {QD_W{1'b0}};
+      end
+      for (xi = 0; xi < 4; xi = xi + 1) begin
+        x_vw[xi] <= {VLW{1'b0}};
+        x_vv[xi] <= {VLW{1'b0}};
+      end
+    end else if (in_x_we) begin
+      if (!x_g) begin
+        if (x_f < 4'd3)       x_jw[{x_j, x_f[1:0]}] <= in_x_data[JWW-1:0];
+        else if (x_f < 4'd6)  x_jv[{x_j, x_f3}] <= in_x_data[JVW-1:0];
+        else if (x_f == 4'd6) x_q[x_j] <= in_x_data[ANG_W-1:0];
+        else if (x_f == 4'd7) x_warm[x_j] <= in_x_data[QD_W-1:0];
+      end else begin
+        if (x_f < 4'd3)       x_vw[x_f[1:0]] <= in_x_data[VLW-1:0];
+        else if (x_f < 4'd6)  x_vv[x_f3] <= in_x_data[VLW-1:0];
+      end
+    end
+  end
+
+  // ---- sequencer state ---------------------------------------------------------------------------
+  localparam [4:0] S_IDLE = 5'd0, S_WAIT = 5'd1, S_ISSUE = 5'd2, S_RINIT = 5'd3, S_COL = 5'd4,
+                   S_DOTD = 5'd5, S_NORM = 5'd6, S_NORM2 = 5'd7, S_E = 5'd8, S_Y = 5'd9, S_C = 5'd10,
+                   S_BND0 = 5'd11, S_BND1 = 5'd12, S_BND2 = 5'd13, S_BND3 = 5'd14, S_WARM = 5'd15,
+                   S_SWEEP = 5'd16, S_GSH = 5'd17, S_GK = 5'd18, S_QN = 5'd19, S_DQ = 5'd20,
+                   S_NEXTJ = 5'd21, S_QNX = 5'd22, S_QNX2 = 5'd23, S_DONE = 5'd24, S_COLNEXT = 5'd25;
+  // burst modes (six products, one per row, issued on consecutive cycles)
+  localparam [1:0] M_COL = 2'd0, M_DOT = 2'd1, M_RUPD = 2'd2;
+  // multiplier operand selects
+  localparam [3:0] A_L = 4'd0, A_JS = 4'd1, A_M = 4'd2, A_Y0 = 4'd3, A_MU = 4'd4, A_KLIM = 4'd5,
+                   A_GK = 4'd6, A_QD = 4'd7;
+  localparam [3:0] B_JW = 4'd0, B_VW = 4'd1, B_JS = 4'd2, B_E = 4'd3, B_Y = 4'd4, B_DLO = 4'd5,
+                   B_DHI = 4'd6, B_RB = 4'd7, B_RO = 4'd8, B_C = 4'd9, B_DT = 4'd10, B_Y0 = 4'd11;
+
+  reg [4:0]       state, ret, bret;
+  reg [7:0]       wt;
+  reg [1:0]       mode;
+  reg             is_v;          // the column burst scales the target V
+  reg [2:0]       bi;            // burst row
+  reg [7:0]       bdrain;
+  reg [JI_W-1:0]  col;
+  reg [JI_W:0]    n_q;
+  reg [SW_W-1:0]  sweep;
+  reg [3:0]       asel, bsel;
+  reg [3:0]       tag_q;         // {valid, row} of the product issued this cycle
+  reg signed [ACW-1:0] acc;
+  reg [MNF:0]     mr_q;          // mantissa m = d 2^-k (MNF + 1 bits, leading one at the top)
+  reg signed [KW-1:0] k_q;
+  reg             dzero;
+  reg signed [RCW-1:0] y0_q;
+  reg signed [RCW-1:0] e_q;
+  reg signed [RCW-1:0] y_q;
+  reg signed [PLW-1:0] plo_q, phi_q;
+  reg signed [QD_W-1:0] lo_q, hi_q;
+  reg             lo_pos_q, hi_pos_q;
+  reg signed [QD_W-1:0] rb_q;    // residual-update multiplier (q'_i at init, dq in the sweeps)
+  reg signed [GXW-1:0] gsh_q;
+  reg signed [GKW-1:0] gk_q;
+  reg signed [QD_W-1:0] qnc_q;
+  reg [31:0]      flags;
+
+  wire [1:0] jrow = (bi < 3'd3) ? bi[1:0] : 2'd0;
+
+  // ---- shared multiplier -------------------------------------------------------------------------
+  // a operands sign-extended to MAW bits
+  wire signed [MAW-1:0] a_L, a_js, a_m, a_y0, a_mu, a_klim, a_gk, a_qd;
+  wire signed [JSW-1:0] js_bi = js[{col, bi}];
+  ts_resize #(.IN_W(LCW), .LSH(0), .OUT_W(MAW)) u_aL (.in(cfg_L), .out(a_L));
+  ts_resize #(.IN_W(JSW), .LSH(0), .OUT_W(MAW)) u_ajs (.in(js_bi), .out(a_js));
+  ts_resize #(.IN_W(MNF + 2), .LSH(0), .OUT_W(MAW)) u_am (.in({1'b0, mr_q}), .out(a_m));
+  ts_resize #(.IN_W(RCW), .LSH(0), .OUT_W(MAW)) u_ay0 (.in(y0_q), .out(a_y0));
+  ts_resize #(.IN_W(MUW), .LSH(0), .OUT_W(MAW)) u_amu (.in(cfg_mu[col]), .out(a_mu));
+  ts_resize #(.IN_W(KLW), .LSH(0), .OUT_W(MAW)) u_akl (.in(cfg_klim), .out(a_klim));
+  ts_resize #(.IN_W(GKW), .LSH(0), .OUT_W(MAW)) u_agk (.in(gk_q), .out(a_gk));
+  ts_resize #(.IN_W(QD_W), .LSH(0), .OUT_W(MAW)) u_aqd (.in(qd[col]), .out(a_qd));
+  // b operands sign-extended to MBW bits
+  wire signed [QFW-1:0] dlo, dhi;        // cvt<qdiff_t>(lo - q), cvt<qdiff_t>(hi - q)
+  wire [6*TW_W-1:0] ro_f;               // cvt<tw_t>(racc), row a at [a*TW_W +: TW_W]
+  wire signed [MBW-1:0] b_jw, b_vw, b_js, b_e, b_y, b_dlo, b_dhi, b_rb, b_ro, b_c, b_dt, b_y0;
+  wire signed [TW_W-1:0] ro_bi = ro_f[bi*TW_W +: TW_W];
+  ts_resize #(.IN_W(JWW), .LSH(0), .OUT_W(MBW)) u_bjw (.in(x_jw[{col, jrow}]), .out(b_jw));
+  ts_resize #(.IN_W(VLW), .LSH(0), .OUT_W(MBW)) u_bvw (.in(x_vw[jrow]), .out(b_vw));
+  ts_resize #(.IN_W(JSW), .LSH(0), .OUT_W(MBW)) u_bjs (.in(js_bi), .out(b_js));
+  ts_resize #(.IN_W(EW), .LSH(0), .OUT_W(MBW)) u_be (.in(e_q), .out(b_e));
+  ts_resize #(.IN_W(RCW), .LSH(0), .OUT_W(MBW)) u_by (.in(y_q), .out(b_y));
+  ts_resize #(.IN_W(RCW), .LSH(0), .OUT_W(MBW)) u_by0 (.in(y0_q), .out(b_y0));
+  ts_resize #(.IN_W(QFW), .LSH(0), .OUT_W(MBW)) u_bdlo (.in(dlo), .out(b_dlo));
+  ts_resize #(.IN_W(QFW), .LSH(0), .OUT_W(MBW)) u_bdhi (.in(dhi), .out(b_dhi));
+  ts_resize #(.IN_W(QD_W), .LSH(0), .OUT_W(MBW)) u_brb (.in(rb_q), .out(b_rb));
+  ts_resize #(.IN_W(TW_W), .LSH(0), .OUT_W(MBW)) u_bro (.in(ro_bi), .out(b_ro));
+  ts_resize #(.IN_W(STW), .LSH(0), .OUT_W(MBW)) u_bc (.in(cst[col]), .out(b_c));
+  ts_resize #(.IN_W(DTW), .LSH(0), .OUT_W(MBW)) u_bdt (.in(cfg_dt), .out(b_dt));
+
+  reg signed [MAW-1:0] mul_a;
+  reg signed [MBW-1:0] mul_b;
+  wire signed [PW-1:0] p;
+  ts_mul #(.A_W(MAW), .B_W(MBW), .TARGET(TARGET)) u_mul (.clk(clk), .rst(rst), .a(mul_a), .b(mul_b), .p(p));
+
+  reg signed [MAW-1:0] a_sel;
+  reg signed [MBW-1:0] b_sel;
+  always @* begin
+    case (asel)
+      A_L:     a_sel = a_L;
+      A_JS:    a_sel = a_js;
+      A_M:     a_sel = a_m;
+      A_Y0:    a_sel = a_y0;
+      A_MU:    a_sel = a_mu;
+      A_KLIM:  a_sel = a_klim;
+      A_GK:    a_sel = a_gk;
+      default: a_sel = a_qd;
+    endcase
+    case (bsel)
+      B_JW:    b_sel = (bi < 3'd3) ? b_jw : {MBW{1'b0}};
+      B_VW:    b_sel = (bi < 3'd3) ? b_vw : {MBW{1'b0}};
+      B_JS:    b_sel = b_js;
+      B_E:     b_sel = b_e;
+      B_Y:     b_sel = b_y;
+      B_DLO:   b_sel = b_dlo;
+      B_DHI:   b_sel = b_dhi;
+      B_RB:    b_sel = b_rb;
+      B_RO:    b_sel = b_ro;
+      B_C:     b_sel = b_c;
+      B_DT:    b_sel = b_dt;
+      default: b_sel = b_y0;
+    endcase
+  end
+
+  // product tags: {valid, row} at the product (tag_p) and after a rounder (tag_r)
+  wire [3:0] tag_p, tag_r;
+  ts_delay #(.W(4), .DEPTH(MLAT)) u_tagp (.clk(clk), .rst(rst), .din(tag_q), .dout(tag_p));
+  ts_delay #(.W(4), .DEPTH(RL)) u_tagr (.clk(clk), .rst(rst), .din(tag_p), .dout(tag_r));
+  wire [2:0] row_p = tag_p[2:0];
+  wire [2:0] row_r = tag_r[2:0];
+  wire [1:0] vrow_p = (row_p >= 3'd3) ? (row_p[1:0] - 2'd3) : 2'd0;
+
+  // ---- rounders (the model's cvt) --------------------------------------------------------------
+  // columns and target: cvt<jsc_t>(L w), cvt<jsc_t>(v), cvt<tw_t>(L V_w), cvt<tw_t>(V_v)
+  wire signed [LCW+JWW-1:0] p_lj;
+  wire signed [LCW+VLW-1:0] p_lv;
+  ts_resize #(.IN_W(PW), .LSH(0), .OUT_W(LCW + JWW)) u_plj (.in(p), .out(p_lj));
+  ts_resize #(.IN_W(PW), .LSH(0), .OUT_W(LCW + VLW)) u_plv (.in(p), .out(p_lv));
+  wire signed [JSW-1:0] jsl_o, jsv_o;
+  wire signed [TW_W-1:0] twl_o, twv_o;
+  wire jsl_s, jsv_s, twl_s, twv_s;
+  ts_round_sat #(.IN_W(LCW + JWW), .SHIFT(TS_LCHAR_F + TS_JW_F - JSF), .OUT_W(JSW), .SAT(1))
+    u_r_jsl (.clk(clk), .rst(rst), .in_x(p_lj), .out_y(jsl_o), .out_sat(jsl_s));
+  ts_round_sat #(.IN_W(JVW), .SHIFT(TS_JV_F - JSF), .OUT_W(JSW), .SAT(1))
+    u_r_jsv (.clk(clk), .rst(rst), .in_x(x_jv[{col, vrow_p}]), .out_y(jsv_o), .out_sat(jsv_s));
+  ts_round_sat #(.IN_W(LCW + VLW), .SHIFT(TS_LCHAR_F + TS_VEL_F - TWF), .OUT_W(TW_W), .SAT(1))
+    u_r_twl (.clk(clk), .rst(rst), .in_x(p_lv), .out_y(twl_o), .out_sat(twl_s));
+  ts_round_sat #(.IN_W(VLW), .SHIFT(TS_VEL_F - TWF), .OUT_W(TW_W), .SAT(1))
+    u_r_twv (.clk(clk), .rst(rst), .in_x(x_vv[vrow_p]), .out_y(twv_o), .out_sat(twv_s));
+
+  // reciprocal: e = cvt<e_t>(1 - m y0), y = cvt<recip_t>(y0 + y0 e), c = cvt<step_t>(mu y)
+  wire signed [EIW-1:0] p_e, one_e, e_in;
+  ts_resize #(.IN_W(PW), .LSH(0), .OUT_W(EIW)) u_pe (.in(p), .out(p_e));
+  assign one_e = {{(EIW - 1){1'b0}}, 1'b1} <<< (MNF + RCF);
+  assign e_in = one_e - p_e;
+  wire signed [EW-1:0] e_o;
+  wire e_s;
+  ts_round_sat #(.IN_W(EIW), .SHIFT(MNF + RCF - EF), .OUT_W(EW), .SAT(1))
+    u_r_e (.clk(clk), .rst(rst), .in_x(e_in), .out_y(e_o), .out_sat(e_s));
+  wire signed [YIW-1:0] p_y, y0_al, y_in;
+  ts_resize #(.IN_W(PW), .LSH(0), .OUT_W(YIW)) u_py (.in(p), .out(p_y));
+  ts_resize #(.IN_W(RCW), .LSH(EF), .OUT_W(YIW)) u_y0al (.in(y0_q), .out(y0_al));
+  assign y_in = y0_al + p_y;
+  wire signed [RCW-1:0] y_o;
+  wire y_s;
+  ts_round_sat #(.IN_W(YIW), .SHIFT(EF), .OUT_W(RCW), .SAT(1))
+    u_r_y (.clk(clk), .rst(rst), .in_x(y_in), .out_y(y_o), .out_sat(y_s));
+  wire signed [MUW+RCW-1:0] p_c;
+  ts_resize #(.IN_W(PW), .LSH(0), .OUT_W(MUW + RCW)) u_pc (.in(p), .out(p_c));
+  wire signed [STW-1:0] c_o;
+  wire c_s;
+  ts_round_sat #(.IN_W(MUW + RCW), .SHIFT(TS_MU_F + RCF - TS_STEP_F), .OUT_W(STW), .SAT(1))
+    u_r_c (.clk(clk), .rst(rst), .in_x(p_c), .out_y(c_o), .out_sat(c_s));
+
+  // bounds: vmin = cvt<qd_t>(-vmax), cvt<qdiff_t>(lo - q), cvt<qdiff_t>(hi - q), cvt<qd_t>(klim d)
+  wire signed [QD_W:0] vmax_x;
+  ts_resize #(.IN_W(QD_W), .LSH(0), .OUT_W(QD_W + 1)) u_vmx (.in(cfg_vmax[col]), .out(vmax_x));
+  wire signed [QD_W:0] nvmax = -vmax_x;
+  wire signed [QD_W-1:0] vmin_o;
+  wire vmin_s;
+  ts_round_sat #(.IN_W(QD_W + 1), .SHIFT(0), .OUT_W(QD_W), .SAT(1))
+    u_r_vmin (.clk(clk), .rst(rst), .in_x(nvmax), .out_y(vmin_o), .out_sat(vmin_s));
+  wire signed [ANG_W:0] lo_x, hi_x, q_x;
+  ts_resize #(.IN_W(ANG_W), .LSH(0), .OUT_W(ANG_W + 1)) u_lox (.in(cfg_lo[col]), .out(lo_x));
+  ts_resize #(.IN_W(ANG_W), .LSH(0), .OUT_W(ANG_W + 1)) u_hix (.in(cfg_hi[col]), .out(hi_x));
+  ts_resize #(.IN_W(ANG_W), .LSH(0), .OUT_W(ANG_W + 1)) u_qx (.in(x_q[col]), .out(q_x));
+  wire signed [ANG_W:0] dlo_in = lo_x - q_x;
+  wire signed [ANG_W:0] dhi_in = hi_x - q_x;
+  wire dlo_s, dhi_s;
+  ts_round_sat #(.IN_W(ANG_W + 1), .SHIFT(AF - TS_QDIFF_F), .OUT_W(QFW), .SAT(1))
+    u_r_dlo (.clk(clk), .rst(rst), .in_x(dlo_in), .out_y(dlo), .out_sat(dlo_s));
+  ts_round_sat #(.IN_W(ANG_W + 1), .SHIFT(AF - TS_QDIFF_F), .OUT_W(QFW), .SAT(1))
+    u_r_dhi (.clk(clk), .rst(rst), .in_x(dhi_in), .out_y(dhi), .out_sat(dhi_s));
+  wire signed [PLW-1:0] p_pl;
+  ts_resize #(.IN_W(PW), .LSH(0), .OUT_W(PLW)) u_ppl (.in(p), .out(p_pl));
+  wire signed [QD_W-1:0] plo_o, phi_o;
+  wire plo_s, phi_s;
+  ts_round_sat #(.IN_W(PLW), .SHIFT(PLF - QDF), .OUT_W(QD_W), .SAT(1))
+    u_r_plo (.clk(clk), .rst(rst), .in_x(plo_q), .out_y(plo_o), .out_sat(plo_s));
+  ts_round_sat #(.IN_W(PLW), .SHIFT(PLF - QDF), .OUT_W(QD_W), .SAT(1))
+    u_r_phi (.clk(clk), .rst(rst), .in_x(phi_q), .out_y(phi_o), .out_sat(phi_s));
+  // exact comparisons of the position bounds with the velocity interval
+  wire signed [CMW-1:0] vmin_c, vmax_c, plo_c, phi_c;
+  ts_resize #(.IN_W(QD_W), .LSH(PLF - QDF), .OUT_W(CMW)) u_vminc (.in(vmin_o), .out(vmin_c));
+  ts_resize #(.IN_W(QD_W), .LSH(PLF - QDF), .OUT_W(CMW)) u_vmaxc (.in(cfg_vmax[col]), .out(vmax_c));
+  ts_resize #(.IN_W(PLW), .LSH(0), .OUT_W(CMW)) u_ploc (.in(plo_q), .out(plo_c));
+  ts_resize #(.IN_W(PLW), .LSH(0), .OUT_W(CMW)) u_phic (.in(phi_q), .out(phi_c));
+
+  // residual: racc = cvt<tacc_t>(racc - Js_i b) at the product of a residual-update burst
+  wire signed [RIW-1:0] racc_al, p_ral, racc_in;
+  wire signed [TAW-1:0] racc_p = racc[row_p];
+  ts_resize #(.IN_W(TAW), .LSH(RSF - TAF), .OUT_W(RIW)) u_rcal (.in(racc_p), .out(racc_al));
+  ts_resize #(.IN_W(PW), .LSH(RSF - RPF), .OUT_W(RIW)) u_pral (.in(p), .out(p_ral));
+  assign racc_in = racc_al - p_ral;
+  wire signed [TAW-1:0] racc_o;
+  wire racc_s;
+  ts_round_sat #(.IN_W(RIW), .SHIFT(RSF - TAF), .OUT_W(TAW), .SAT(1))
+    u_r_racc (.clk(clk), .rst(rst), .in_x(racc_in), .out_y(racc_o), .out_sat(racc_s));
+  // ro = cvt<tw_t>(racc) per row (the sweep operand and, at the end, r); racc init = vs exactly
+  wire [5:0] ro_s;
+  wire [6*TAW-1:0] vs_al;
+  genvar gr;
+  generate
+    for (gr = 0; gr < 6; gr = gr + 1) begin : g_row
+      ts_round_sat #(.IN_W(TAW), .SHIFT(TAF - TWF), .OUT_W(TW_W), .SAT(1))
+        u_r_ro (.clk(clk), .rst(rst), .in_x(racc[gr]), .out_y(ro_f[gr*TW_W +: TW_W]), .out_sat(ro_s[gr]));
+      ts_resize #(.IN_W(TW_W), .LSH(TAF - TWF), .OUT_W(TAW)) u_vsal (.in(vs[gr]), .out(vs_al[gr*TAW +: TAW]));
+    end
+  endgenerate
+
+  // g 2^-k: t = s + GLS >= 0, round half up then arithmetic shift (cvt_shr), saturate in u_r_gk
+  wire signed [GW-1:0] g_w;
+  ts_resize #(.IN_W(ACW), .LSH(0), .OUT_W(GW)) u_gw (.in(acc), .out(g_w));
+  wire signed [GXW-1:0] g_x;
+  ts_resize #(.IN_W(GW), .LSH(GLS), .OUT_W(GXW)) u_gx (.in(g_w), .out(g_x));
+  wire signed [9:0] t_s = {{(10 - KW){kst[col][KW-1]}}, kst[col]} + TOFF10;
+  wire [6:0] t_u = t_s[6:0];
+  wire [GXW-1:0] one_g = {{(GXW - 1){1'b0}}, 1'b1};
+  wire signed [GXW-1:0] half_g = (t_u == 7'd0) ? {GXW{1'b0}} : $signed(one_g << (t_u - 7'd1));
+  wire signed [GXW-1:0] gsh = (g_x + half_g) >>> t_u;
+  wire unused_t = ^t_s[9:7];
+  wire signed [GKW-1:0] gk_o;
+  wire gk_s;
+  ts_round_sat #(.IN_W(GXW), .SHIFT(0), .OUT_W(GKW), .SAT(1))
+    u_r_gk (.clk(clk), .rst(rst), .in_x(gsh_q), .out_y(gk_o), .out_sat(gk_s));
+
+  // qn = cvt<qd_t>(q' + gk c), dq = cvt<qd_t>(qn - q')
+  wire signed [QIW-1:0] qd_al, p_qal, qn_in;
+  ts_resize #(.IN_W(QD_W), .LSH(QSF - QDF), .OUT_W(QIW)) u_qdal (.in(qd[col]), .out(qd_al));
+  ts_resize #(.IN_W(PW), .LSH(QSF - QPF), .OUT_W(QIW)) u_pqal (.in(p), .out(p_qal));
+  assign qn_in = qd_al + p_qal;
+  wire signed [QD_W-1:0] qn_o;
+  wire qn_s;
+  ts_round_sat #(.IN_W(QIW), .SHIFT(QSF - QDF), .OUT_W(QD_W), .SAT(1))
+    u_r_qn (.clk(clk), .rst(rst), .in_x(qn_in), .out_y(qn_o), .out_sat(qn_s));
+  wire signed [QD_W:0] qnc_x, qd_x;
+  ts_resize #(.IN_W(QD_W), .LSH(0), .OUT_W(QD_W + 1)) u_qncx (.in(qnc_q), .out(qnc_x));
+  ts_resize #(.IN_W(QD_W), .LSH(0), .OUT_W(QD_W + 1)) u_qdx (.in(qd[col]), .out(qd_x));
+  wire signed [QD_W:0] dq_in = qnc_x - qd_x;
+  wire signed [QD_W-1:0] dq_o;
+  wire dq_s;
+  ts_round_sat #(.IN_W(QD_W + 1), .SHIFT(0), .OUT_W(QD_W), .SAT(1))
+    u_r_dq (.clk(clk), .rst(rst), .in_x(dq_in), .out_y(dq_o), .out_sat(dq_s));
+
+  // q_next = cvt<angle_t>(q + q' dt)
+  wire signed [NIW-1:0] q_al, p_nal, qx_in;
+  ts_resize #(.IN_W(ANG_W), .LSH(NSF - AF), .OUT_W(NIW)) u_qal (.in(x_q[col]), .out(q_al));
+  ts_resize #(.IN_W(PW), .LSH(NSF - NPF), .OUT_W(NIW)) u_pnal (.in(p), .out(p_nal));
+  assign qx_in = q_al + p_nal;
+  wire signed [ANG_W-1:0] qx_o;
+  wire qx_s;
+  ts_round_sat #(.IN_W(NIW), .SHIFT(NSF - AF), .OUT_W(ANG_W), .SAT(1))
+    u_r_qx (.clk(clk), .rst(rst), .in_x(qx_in), .out_y(qx_o), .out_sat(qx_s));
+
+  // ---- combinational helpers -------------------------------------------------------------------
+  // leading one of d = |Js_i|^2 (>= 0) and the normalised mantissa
+  wire [DW-1:0] dval;
+  ts_resize #(.IN_W(ACW), .LSH(0), .OUT_W(DW)) u_dv (.in(acc), .out(dval));
+  reg [6:0] msb;
+  integer bb;
+  always @* begin
+    msb = 7'd0;
+    for (bb = 0; bb < DW; bb = bb + 1)
+      if (dval[bb]) msb = bb[6:0];
+  end
+  wire [DW-1:0] dn = dval << (7'd0 + (DW - 1) - msb);
+  wire unused_dn = ^dn[DW-MNF-2:0];
+  wire signed [KW-1:0] k_new = $signed({1'b0, msb}) - DPF_K;
+
+  // reciprocal seed table
+  (* rom_style = "logic" *) reg [RCW-1:0] rom [0:(1 << T)-1];
+  initial $readmemh(ROM_FILE, rom);
+
+  // warm start with its leak, clamped into this tick's box
+  wire signed [QD_W-1:0] warm_x = x_warm[col];
+  wire signed [QD_W-1:0] warm_sh = warm_x >>> cfg_leak;
+  wire signed [QD_W-1:0] warm_l = (cfg_leak == 5'd0) ? warm_x : (warm_x - warm_sh);
+  wire signed [QD_W-1:0] warm_t = (hi_q < warm_l) ? hi_q : warm_l;
+  wire signed [QD_W-1:0] warm_c = (lo_q < warm_t) ? warm_t : lo_q;
+  // sweep step clamp
+  wire signed [QD_W-1:0] qn_t = (bhi[col] < qn_o) ? bhi[col] : qn_o;
+  wire signed [QD_W-1:0] qn_c = (blo[col] < qn_t) ? qn_t : blo[col];
+  // integration clamp
+  wire signed [ANG_W-1:0] qx_t = (cfg_hi[col] < qx_o) ? cfg_hi[col] : qx_o;
+  wire signed [ANG_W-1:0] qx_c = (cfg_lo[col] < qx_t) ? qx_t : cfg_lo[col];
+  // active-limit flags of joint col
+  wire lo_hit = !(blo[col] < qd[col]);
+  wire hi_hit = !(qd[col] < bhi[col]);
+  wire lim_act = (blo_pos[col] && lo_hit) || (bhi_pos[col] && hi_hit);
+  wire vlim_act = ((!blo_pos[col] && lo_hit) || (!bhi_pos[col] && hi_hit))
+                  && (cfg_vmax[col] != {1'b0, {(QD_W - 1){1'b1}}});
+
+  wire last_col = ({1'b0, col} == n_q - 1'b1);
+  wire signed [ACW-1:0] p_acc;
+  ts_resize #(.IN_W(PW), .LSH(0), .OUT_W(ACW)) u_pacc (.in(p), .out(p_acc));
+
+  // ---- sequencer -----------------------------------------------------------------------------------
+  always @(posedge clk) begin
+    if (rst) begin
+      state <= S_IDLE; ret <= S_IDLE; bret <= S_IDLE; wt <= 8'd0; mode <= M_COL; is_v <= 1'b0;
+      bi <= 3'd0; bdrain <= 8'd0; col <= {JI_W{1'b0}}; n_q <= {(JI_W + 1){1'b0}}; sweep <= {SW_W{1'b0}};
+      asel <= A_L; bsel <= B_JW; tag_q <= 4'd0; mul_a <= {MAW{1'b0}}; mul_b <= {MBW{1'b0}};
+      acc <= {ACW{1'b0}}; mr_q <= {(MNF + 1){1'b0}}; k_q <= {KW{1'b0}}; dzero <= 1'b0;
+      y0_q <= {RCW{1'b0}}; e_q <= {RCW{1'b0}}; y_q <= {RCW{1'b0}};
+      plo_q <= {PLW{1'b0}}; phi_q <= {PLW{1'b0}}; lo_q <= {QD_W{1'b0}}; hi_q <= {QD_W{1'b0}};
+      lo_pos_q <= 1'b0; hi_pos_q <= 1'b0; rb_q <= {QD_W{1'b0}}; gsh_q <= {GXW{1'b0}}; gk_q <= {GKW{1'b0}};
+      qnc_q <= {QD_W{1'b0}}; flags <= 32'd0;
+      out_busy <= 1'b0; out_done <= 1'b0; out_r <= {(6 * TW_W){1'b0}}; out_flags <= 32'd0;
+      for (ri = 0; ri < NMAX; ri = ri + 1) begin
+        cst[ri] <= {STW{1'b0}}; kst[ri] <= {KW{1'b0}}; blo[ri] <= {QD_W{1'b0}}; bhi[ri] <= {QD_W{1'b0}};
+        blo_pos[ri] <= 1'b0; bhi_pos[ri] <= 1'b0; qd[ri] <= {QD_W{1'b0}}; qnext[ri] <= {ANG_W{1'b0}};
+      end
+      for (ri = 0; ri < 6; ri = ri + 1) begin
+        vs[ri] <= {TW_W{1'b0}}; racc[ri] <= {TAW{1'b0}};
+      end
+    end else begin
+      out_done <= 1'b0;
+      tag_q <= 4'd0;
+      mul_a <= a_sel;
+      mul_b <= b_sel;
+
+      // burst sinks
+      if (tag_p[3] && (mode == M_DOT)) acc <= acc + p_acc;
+      if (tag_r[3] && (mode == M_COL)) begin
+        if (is_v) begin
+          vs[row_r] <= (row_r < 3'd3) ? twl_o : twv_o;
+          if ((row_r < 3'd3) ? twl_s : twv_s) flags[8] <= 1'b1;
+        end else begin
+          js[{col, row_r}] <= (row_r < 3'd3) ? jsl_o : jsv_o;
+          if ((row_r < 3'd3) ? jsl_s : jsv_s) flags[8] <= 1'b1;
+        end
+      end
+      if (tag_r[3] && (mode == M_RUPD)) begin
+        racc[row_r] <= racc_o;
+        if (racc_s) flags[8] <= 1'b1;
+      end
+
+      case (state)
+        S_IDLE: begin
+          if (in_start) begin
+            out_busy <= 1'b1;
+            flags <= 32'd0;
+            n_q <= in_n;
+            col <= {JI_W{1'b0}};
+            // target: L V_w and V_v
+            is_v <= 1'b1;
+            mode <= M_COL; asel <= A_L; bsel <= B_VW; bi <= 3'd0; bdrain <= ML8 + 8'd2;
+            bret <= S_RINIT;
+            state <= S_ISSUE;
+          end
+        end
+        S_WAIT: begin
+          if (wt == 8'd0) state <= ret;
+          else wt <= wt - 1'b1;
+        end
+        S_ISSUE: begin
+          // operands of row bi are registered into the multiplier this cycle
+          tag_q <= {1'b1, bi};
+          if ((mode == M_DOT) && (bi == 3'd0)) acc <= {ACW{1'b0}};
+          if (bi == 3'd5) begin
+            bi <= 3'd0;
+            wt <= bdrain;
+            ret <= bret;
+            state <= S_WAIT;
+          end else begin
+            bi <= bi + 1'b1;
+          end
+        end
+        S_RINIT: begin
+          for (ri = 0; ri < 6; ri = ri + 1) racc[ri] <= vs_al[ri*TAW +: TAW];
+          is_v <= 1'b0;
+          state <= S_COL;
+        end
+        S_COL: begin
+          // scaled column col
+          mode <= M_COL; asel <= A_L; bsel <= B_JW; bi <= 3'd0; bdrain <= ML8 + 8'd2;
+          bret <= S_DOTD;
+          state <= S_ISSUE;
+        end
+        S_DOTD: begin
+          mode <= M_DOT; asel <= A_JS; bsel <= B_JS; bi <= 3'd0; bdrain <= ML8;
+          bret <= S_NORM;
+          state <= S_ISSUE;
+        end
+        S_NORM: begin
+          mr_q <= dn[DW-1 -: MNF + 1];
+          k_q <= k_new;
+          dzero <= (dval == {DW{1'b0}});
+          state <= S_NORM2;
+        end
+        S_NORM2: begin
+          y0_q <= rom[mr_q[MNF-1 -: T]];
+          if (dzero) begin
+            cst[col] <= {STW{1'b0}};
+            kst[col] <= {KW{1'b0}};
+            state <= S_BND0;
+          end else begin
+            // m y0 (operands registered in the next cycle, when y0_q holds the seed)
+            asel <= A_M; bsel <= B_Y0;
+            wt <= ML8 + 8'd1 + 8'd1;
+            ret <= S_E;
+            state <= S_WAIT;
+          end
+        end
+        S_E: begin
+          e_q <= e_o;
+          if (e_s) flags[8] <= 1'b1;
+          asel <= A_Y0; bsel <= B_E;
+          wt <= ML8 + 8'd2;
+          ret <= S_Y;
+          state <= S_WAIT;
+        end
+        S_Y: begin
+          y_q <= y_o;
+          if (y_s) flags[8] <= 1'b1;
+          asel <= A_MU; bsel <= B_Y;
+          wt <= ML8 + 8'd2;
+          ret <= S_C;
+          state <= S_WAIT;
+        end
+        S_C: begin
+          cst[col] <= c_o;
+          kst[col] <= k_q;
+          if (c_s) flags[8] <= 1'b1;
+          state <= S_BND0;
+        end
+        S_BND0: begin
+          // vmin, qdiff rounders have had their inputs since the column started
+          if (vmin_s) flags[8] <= 1'b1;
+          if (cfg_lim[col] && (dlo_s || dhi_s)) flags[8] <= 1'b1;
+          asel <= A_KLIM; bsel <= B_DLO;
+          wt <= ML8;
+          ret <= S_BND1;
+          state <= S_WAIT;
+        end
+        S_BND1: begin
+          plo_q <= p_pl;
+          bsel <= B_DHI;
+          wt <= ML8;
+          ret <= S_BND2;
+          state <= S_WAIT;
+        end
+        S_BND2: begin
+          phi_q <= p_pl;
+          wt <= 8'd2;
+          ret <= S_BND3;
+          state <= S_WAIT;
+        end
+        S_BND3: begin
+          lo_q <= vmin_o; hi_q <= cfg_vmax[col]; lo_pos_q <= 1'b0; hi_pos_q <= 1'b0;
+          if (cfg_lim[col]) begin
+            if (vmin_c < plo_c) begin
+              lo_pos_q <= 1'b1;
+              if (vmax_c < plo_c) lo_q <= cfg_vmax[col];
+              else begin
+                lo_q <= plo_o;
+                if (plo_s) flags[8] <= 1'b1;
+              end
+            end
+            if (phi_c < vmax_c) begin
+              hi_pos_q <= 1'b1;
+              if (phi_c < vmin_c) hi_q <= vmin_o;
+              else begin
+                hi_q <= phi_o;
+                if (phi_s) flags[8] <= 1'b1;
+              end
+            end
+          end
+          state <= S_WARM;
+        end
+        S_WARM: begin
+          blo[col] <= lo_q; bhi[col] <= hi_q; blo_pos[col] <= lo_pos_q; bhi_pos[col] <= hi_pos_q;
+          qd[col] <= warm_c;
+          rb_q <= warm_c;
+          // racc -= Js_col q'_col
+          mode <= M_RUPD; asel <= A_JS; bsel <= B_RB; bi <= 3'd0; bdrain <= ML8 + 8'd4;
+          bret <= S_COLNEXT;
+          state <= S_ISSUE;
+        end
+        S_COLNEXT: begin
+          if (last_col) begin
+            col <= {JI_W{1'b0}};
+            sweep <= {SW_W{1'b0}};
+            state <= S_SWEEP;
+          end else begin
+            col <= col + 1'b1;
+            state <= S_COL;
+          end
+        end
+        S_SWEEP: begin
+          // one coordinate step of joint col: g = <Js_col, cvt<tw_t>(racc)>
+          if (sweep == cfg_sweeps) begin
+            col <= {JI_W{1'b0}};
+            state <= S_QNX;
+          end else begin
+            if (|ro_s) flags[8] <= 1'b1;
+            mode <= M_DOT; asel <= A_JS; bsel <= B_RO; bi <= 3'd0; bdrain <= ML8;
+            bret <= S_GSH;
+            state <= S_ISSUE;
+          end
+        end
+        S_GSH: begin
+          gsh_q <= gsh;
+          wt <= 8'd1;
+          ret <= S_GK;
+          state <= S_WAIT;
+        end
+        S_GK: begin
+          gk_q <= gk_o;
+          if (gk_s) flags[8] <= 1'b1;
+          asel <= A_GK; bsel <= B_C;
+          wt <= ML8 + 8'd2;
+          ret <= S_QN;
+          state <= S_WAIT;
+        end
+        S_QN: begin
+          if (qn_s) flags[8] <= 1'b1;
+          qnc_q <= qn_c;
+          wt <= 8'd1;
+          ret <= S_DQ;
+          state <= S_WAIT;
+        end
+        S_DQ: begin
+          if (dq_s) flags[8] <= 1'b1;
+          rb_q <= dq_o;
+          qd[col] <= qnc_q;
+          mode <= M_RUPD; asel <= A_JS; bsel <= B_RB; bi <= 3'd0; bdrain <= ML8 + 8'd4;
+          bret <= S_NEXTJ;
+          state <= S_ISSUE;
+        end
+        S_NEXTJ: begin
+          if (last_col) begin
+            col <= {JI_W{1'b0}};
+            sweep <= sweep + 1'b1;
+          end else begin
+            col <= col + 1'b1;
+          end
+          state <= S_SWEEP;
+        end
+        S_QNX: begin
+          // q_next = clamp(cvt<angle_t>(q + q' dt)) and the active-limit flags of joint col
+          asel <= A_QD; bsel <= B_DT;
+          wt <= ML8 + 8'd2;
+          ret <= S_QNX2;
+          state <= S_WAIT;
+        end
+        S_QNX2: begin
+          qnext[col] <= cfg_lim[col] ? qx_c : qx_o;
+          if (qx_s) flags[0] <= 1'b1;
+          if (lim_act) flags[16] <= 1'b1;
+          if (vlim_act) flags[17] <= 1'b1;
+          if (last_col) state <= S_DONE;
+          else begin
+            col <= col + 1'b1;
+            state <= S_QNX;
+          end
+        end
+        S_DONE: begin
+          out_r <= ro_f;
+          out_flags <= flags | {23'd0, |ro_s, 8'd0};
+          out_busy <= 1'b0;
+          out_done <= 1'b1;
+          state <= S_IDLE;
+        end
+        default: state <= S_IDLE;
+      endcase
+    end
+  end
+
+
+  generate
+    for (gr = 0; gr < NMAX; gr = gr + 1) begin : g_out
+      assign out_qd[gr*QD_W +: QD_W] = qd[gr];
+      assign out_q_next[gr*ANG_W +: ANG_W] = qnext[gr];
+    end
+  endgenerate
+
+endmodule
+
+`default_nettype wire
