@@ -195,6 +195,8 @@ def make_groups(cfg: str, rng, scale: float):
 
     # random raw cases on full and truncated chains
     chains = [(r, None) for r in ROBOTS] + [("puma560", 1), ("ur5", 2), ("stanford", 3), ("chain20", NMAX)]
+    if scale < 0.5:  # the short run (Icarus): half of the chains, still n = 2, 6, 7 and NMAX
+        chains = [("puma560", None), ("panda", None), ("ur5", 2), ("chain20", NMAX)]
     for name, nj in chains:
         spec = chain_spec(name, nj)
         n = len(spec["joints"])
