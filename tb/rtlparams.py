@@ -167,6 +167,7 @@ DEPS["ts_core_fk"] = ["ts_joint_quat", "ts_sincos", "ts_quat_mul", "ts_quat_rota
                       "ts_resize", "ts_delay", "ts_round_sat"]
 DEPS["ts_core_commit"] = ["ts_mul", "ts_resize", "ts_delay", "ts_ecp5_mult18"]
 DEPS["ts_core_solve"] = ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat", "ts_ecp5_mult18"]
+DEPS["ts_core_law"] = ["ts_quat_mul", "ts_quat_rotate", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"]
 #: the datapath modules (documented, synthesised); the others are shared pieces
 PRIMITIVES = ("ts_quat_mul", "ts_quat_rotate", "ts_sincos", "ts_joint_quat", "ts_screw_transport")
 SHARED = ("ts_round_sat", "ts_mul", "ts_delay", "ts_resize")
@@ -292,6 +293,12 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
                 jobs.append(("ts_core_solve", sources("ts_core_solve", target),
                              {"NMAX": nmax, "CONFIG": config, "TARGET": target,
                               "ROM_FILE": str(RTL / f"ts_recip_rom_{CONFIGS[config]}.mem")}))
+    # the servo law (rtl/ts_core_law.v): both configurations and multiplier targets
+    for config in (0, 1):
+        for target in TARGETS:
+            jobs.append(("ts_core_law", sources("ts_core_law", target),
+                         {"CONFIG": config, "TARGET": target,
+                          "ROM_FILE": str(RTL / f"ts_rotvec_rom_{CONFIGS[config]}.mem")}))
     return jobs
 
 
