@@ -9,6 +9,7 @@ Cases (fresh random, seed printed; replay with TS_SEED=<seed>; TS_NCASE scales t
   - random raw J / V / q / warm on the same chains and on truncated chains (n = 1, 2, 3) and 8 joints
     of chain20, with different L, klim, sweeps (1, 2, 3, 10), mu (0, 1, 1.9, random), warm_leak;
   - joints at, near and beyond their limits, zero (singular) columns, saturating V and warm start.
+TS_NMAX=<N> builds the module with NMAX = N (default 8; the chain20 cases then use min(N, 20) joints).
 Also: no output is X after reset, the busy/done protocol, the cycles per solve (logged), and that the
 format localparams of the module equal the model's formats.
 """
@@ -24,8 +25,8 @@ import rtlparams
 import tsbench
 
 MODULE = "ts_core_solve"
-NMAX = 8
-JI_W = 3
+NMAX = int(os.environ.get("TS_NMAX", "8"))   # TS_NMAX: one-off runs at another NMAX (chain20 gives n <= 20)
+JI_W = max(1, (NMAX - 1).bit_length())
 ROBOTS = ("puma560", "ur5", "panda", "stanford")
 
 try:
@@ -194,9 +195,9 @@ def make_groups(cfg: str, rng, scale: float):
             groups.append((f"{name} tick sweeps={sweeps}", pr, cases))
 
     # random raw cases on full and truncated chains
-    chains = [(r, None) for r in ROBOTS] + [("puma560", 1), ("ur5", 2), ("stanford", 3), ("chain20", NMAX)]
+    chains = [(r, None) for r in ROBOTS] + [("puma560", 1), ("ur5", 2), ("stanford", 3), ("chain20", min(NMAX, 20))]
     if scale < 0.5:  # the short run (Icarus): half of the chains, still n = 2, 6, 7 and NMAX
-        chains = [("puma560", None), ("panda", None), ("ur5", 2), ("chain20", NMAX)]
+        chains = [("puma560", None), ("panda", None), ("ur5", 2), ("chain20", min(NMAX, 20))]
     for name, nj in chains:
         spec = chain_spec(name, nj)
         n = len(spec["joints"])
@@ -348,5 +349,5 @@ def test_ts_core_solve(cfg, sim):
          "ROM_FILE": str(rtlparams.RTL / f"ts_recip_rom_{cfg}.mem"), "TARGET": target}
     scale = os.environ.get("TS_NCASE", "1" if sim == "verilator" else "0.2")
     tsbench.run_bench(toplevel=MODULE, test_file=__file__, sources=rtlparams.sources(MODULE, target),
-                      parameters=p, sim=sim, build_name=f"{cfg}-{target}-{sim}",
-                      env={"TS_CONFIG": cfg, "TS_NCASE": scale})
+                      parameters=p, sim=sim, build_name=f"{cfg}-{target}-{sim}" + ("" if NMAX == 8 else f"-nmax{NMAX}"),
+                      env={"TS_CONFIG": cfg, "TS_NCASE": scale, "TS_NMAX": str(NMAX)})
