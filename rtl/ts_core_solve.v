@@ -356,7 +356,8 @@ module ts_core_solve #(
   wire signed [QFW-1:0] dlo, dhi;        // cvt<qdiff_t>(lo - q), cvt<qdiff_t>(hi - q)
   wire [6*TW_W-1:0] ro_f;               // cvt<tw_t>(racc), row a at [a*TW_W +: TW_W]
   wire signed [MBW-1:0] b_jw, b_vw, b_js, b_e, b_y, b_dlo, b_dhi, b_rb, b_ro, b_c, b_dt, b_y0;
-  wire signed [TW_W-1:0] ro_bi = ro_f[bi*TW_W +: TW_W];
+  wire signed [TW_W-1:0] ro_w [0:7];      // row select without a multiplier on the index
+  wire signed [TW_W-1:0] ro_bi = ro_w[bi];
   ts_resize #(.IN_W(JWW), .LSH(0), .OUT_W(MBW)) u_bjw (.in(x_jw[{col, jrow}]), .out(b_jw));
   ts_resize #(.IN_W(VLW), .LSH(0), .OUT_W(MBW)) u_bvw (.in(x_vw[jrow]), .out(b_vw));
   ts_resize #(.IN_W(JSW), .LSH(0), .OUT_W(MBW)) u_bjs (.in(js_bi), .out(b_js));
@@ -507,7 +508,10 @@ module ts_core_solve #(
       ts_round_sat #(.IN_W(TAW), .SHIFT(TAF - TWF), .OUT_W(TW_W), .SAT(1))
         u_r_ro (.clk(clk), .rst(rst), .in_x(racc[gr]), .out_y(ro_f[gr*TW_W +: TW_W]), .out_sat(ro_s[gr]));
       ts_resize #(.IN_W(TW_W), .LSH(TAF - TWF), .OUT_W(TAW)) u_vsal (.in(vs[gr]), .out(vs_al[gr*TAW +: TAW]));
+      assign ro_w[gr] = ro_f[gr*TW_W +: TW_W];
     end
+    assign ro_w[6] = {TW_W{1'b0}};
+    assign ro_w[7] = {TW_W{1'b0}};
   endgenerate
 
   // g 2^-k: t = s + GLS >= 0, round half up then arithmetic shift (cvt_shr), saturate in u_r_gk
