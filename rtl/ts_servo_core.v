@@ -236,7 +236,7 @@ module ts_servo_core #(
   wire ld_g = ld[LA_W-1];
   wire [JI_W-1:0] ld_j = ld[JI_W+3:4];
   wire [3:0] ld_f = ld[3:0];
-  wire ld_jok = ld_g || ({{(31 - JI_W){1'b0}}, ld_j} < NMAX);
+  wire ld_jok = ld_g || ({{(32 - JI_W){1'b0}}, ld_j} < NMAX);
   wire [JI_W-1:0] lj = ld_jok && !ld_g ? ld_j : {JI_W{1'b0}};
   reg [31:0] fk_cd;
   reg fk_cv;
