@@ -75,6 +75,8 @@ def yosys_script(module: str, params: dict, family: str, out_json: Path | None, 
     files = " ".join(os.path.relpath(f, ROOT) for f in rtlparams.sources(module, params["TARGET"], sim_models=False))
     sets = []
     for k, v in params.items():
+        if isinstance(v, str) and v.startswith(str(ROOT) + os.sep):
+            v = os.path.relpath(v, ROOT)          # the yowasp tools only see the working directory
         sets.append(f'-set {k} "{v}"' if isinstance(v, str) else f"-set {k} {v}")
     lines = []
     if family == "ecp5":
@@ -137,6 +139,10 @@ def run_ecp5(module: str, cfg: str, seeds: list[int], pnr: bool) -> dict:
             text = (ROOT / log).read_text() if (ROOT / log).exists() else ""
             f = re.findall(r"Max frequency for clock\s+'clk':\s+([\d.]+) MHz", text)
             if not f:
+                # a design larger than the device (e.g. more MULT18X18D than it has) does not place
+                if re.search(r"(?i)unable to place|not enough|too many|cells of type", text):
+                    r["fit"] = False
+                    break
                 raise RuntimeError(f"{module}/{cfg}: nextpnr seed {seed} gave no Fmax, see {log}")
             fmax.append(float(f[-1]))
             m = re.search(r"TRELLIS_COMB:\s+(\d+)/", text)
@@ -182,9 +188,13 @@ def table(results: dict, modules: list[str], configs: list[str]) -> str:
             if r is None:
                 continue
             e = r["ecp5"]
-            lat = rtlparams.latency(m, rtlparams.module_params(m, cfg))
+            try:
+                lat = rtlparams.latency(m, rtlparams.module_params(m, cfg))
+            except KeyError:          # sequenced engines: cycles per tick are measured in simulation
+                lat = "-"
             f = e["fmax"]
-            fs = f"{min(f):.1f} / {statistics.median(f):.1f} ({len(f)} seeds)" if f else "-"
+            fs = f"{min(f):.1f} / {statistics.median(f):.1f} ({len(f)} seeds)" if f else (
+                "does not fit LFE5U-85F" if e.get("fit") is False else "-")
             x = r.get("xc7")
             xs = f"{x['LUT']} | {x['FF']} | {x['SRL']} | {x['DSP48E1']} | {x['BRAM18']}" if x else "- | - | - | - | -"
             lines.append(f"| {m} | {cfg} | {lat} | {e['LUT4']} | {e['CCU2C']} | {e['FF']} | {e['MULT18X18D']} | {e['EBR']} "
@@ -206,7 +216,8 @@ def verdict(results: dict) -> str:
         else:
             d = r["ecp5"]["MULT18X18D"]
             out.append(f"- Goal: ts_quat_mul <= {lim} MULT18X18D ({cfg}): {d} -> {'met' if d <= lim else 'MISSED'}.")
-    worst = [(min(r["ecp5"]["fmax"]), m, c) for (m, c), r in results.items() if r["ecp5"]["fmax"]]
+    worst = [(min(r["ecp5"]["fmax"]), m, c) for (m, c), r in results.items()
+             if r["ecp5"]["fmax"] and m in rtlparams.PRIMITIVES]
     if worst:
         f, m, c = min(worst)
         out.append(f"- Goal: every primitive >= {GOAL_FMAX:.0f} MHz post-route (worst seed): slowest {m} {c} "

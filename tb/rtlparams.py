@@ -205,7 +205,15 @@ def module_params(module: str, cfg: str, target: str = "GENERIC", **kw) -> dict:
         return joint_quat(cfg, target, kw.get("rom_path"))
     if module == "ts_screw_transport":
         return screw_transport(cfg, target)
+    if module == "ts_servo_core":
+        return servo_core(cfg, target, kw.get("nmax", 8))
     raise KeyError(module)
+
+
+def servo_core(cfg: str, target: str = "GENERIC", nmax: int = 8) -> dict:
+    """Parameter set of the servo core top (rtl/ts_servo_core.v) for a configuration."""
+    return {"NMAX": nmax, "CONFIG": CONFIGS.index(cfg), "TARGET": target, "TRIG_ROM": str(rom_file(cfg)),
+            "RECIP_ROM": str(RTL / f"ts_recip_rom_{cfg}.mem"), "ROTVEC_ROM": str(RTL / f"ts_rotvec_rom_{cfg}.mem")}
 
 
 # ---- parameter sets of the shared pieces (lint, benches) -------------------------------------------

@@ -7,8 +7,9 @@ basis by the column port; root-basis input columns from Model.jacobian; mode A: 
 and the status bits the servo law can raise (3 ovf_quat, 4 ovf_pos, 6 ovf_jac, 9 ovf_servo; the
 forward kinematics raises none for these chains and the solver never raises them, both checked).
 
-Parametrised over configuration x mode (A, B, error-only: A and B alternately) x simulator.
-Cases per run (TS_NCASE, default 240 on Verilator, 60 on Icarus): PUMA 560, UR5, Panda, Stanford at
+Parametrised over configuration x simulator; every run drives all three modes (A, B, error-only: A and B
+alternately) one after the other, since the mode is an input of the module (TS_MODE=A,B,E selects).
+Cases per mode (TS_NCASE, default 160 on Verilator, 40 on Icarus): PUMA 560, UR5, Panda, Stanford at
 random joint values, gains from small to the top of gain_t, setpoints: zero error, the tool
 quaternion with its sign flipped (q and -q), small and large random errors, 180-degree orientation
 errors (error quaternion w = 0), full-range (saturating) positions, twists and quaternion components.
@@ -204,12 +205,13 @@ if cocotb is not None:
         from cocotb.clock import Clock
         from cocotb.triggers import FallingEdge
         cfg = os.environ["TS_CONFIG"]
-        mode = os.environ["TS_MODE"]
+        modes = os.environ["TS_MODE"].split(",")
         seed = int(os.environ["TS_SEED"])
-        ncase = int(os.environ.get("TS_NCASE", "240"))
-        dut._log.info("config %s, mode %s, seed %d, %d cases", cfg, mode, seed, ncase)
+        ncase = int(os.environ.get("TS_NCASE", "160"))
+        dut._log.info("config %s, modes %s, seed %d, %d cases per mode", cfg, modes, seed, ncase)
         rng = np.random.default_rng(seed)
-        cases = make_cases(cfg, mode, rng, ncase)
+        # the mode is an input of the module: one build runs every mode, one after the other
+        cases = [c for mode in modes for c in make_cases(cfg, mode, rng, ncase)]
 
         cocotb.start_soon(Clock(dut.clk, 10, units="ns").start())
         in_names = (["start", "mode_b", "err_only", "kp", "ko", "col_valid"]
@@ -330,9 +332,8 @@ if cocotb is not None:
 
 
 @pytest.mark.parametrize("sim", tsbench.SIMS)
-@pytest.mark.parametrize("mode", MODES)
 @pytest.mark.parametrize("cfg", tsbench.CONFIGS)
-def test_ts_core_law(cfg, mode, sim):
+def test_ts_core_law(cfg, sim):
     # The ECP5 multiplier variant on Verilator only in the compact configuration: in the default one
     # its ~400 MULT18X18D models take about a minute to build (per run: the build is not reused),
     # which is over this bench's time budget.  ts_mul's own bench checks that both variants are
@@ -340,7 +341,8 @@ def test_ts_core_law(cfg, mode, sim):
     target = tsbench.target_for(sim) if cfg == "compact" else "GENERIC"
     p = {"CONFIG": 0 if cfg == "default" else 1, "ROM_FILE": str(rtlparams.RTL / f"ts_rotvec_rom_{cfg}.mem"),
          "TARGET": target}
-    ncase = os.environ.get("TS_NCASE", "240" if sim == "verilator" else "60")
+    ncase = os.environ.get("TS_NCASE", "160" if sim == "verilator" else "40")   # per mode
     tsbench.run_bench(toplevel=MODULE, test_file=__file__, sources=rtlparams.sources(MODULE, target),
                       parameters=p, sim=sim, build_name=f"{cfg}-{target}-{sim}",
-                      env={"TS_CONFIG": cfg, "TS_MODE": mode, "TS_PARAMS": json.dumps(p), "TS_NCASE": ncase})
+                      env={"TS_CONFIG": cfg, "TS_MODE": os.environ.get("TS_MODE", ",".join(MODES)),
+                           "TS_PARAMS": json.dumps(p), "TS_NCASE": ncase})
