@@ -97,6 +97,14 @@ def _runners():
     return _Verilator, Icarus
 
 
+#: The primitives' benches stream 10,000 fresh random vectors per run on Verilator; Icarus is 10-50x
+#: slower on them, so its runs take ICARUS_NVEC (the same code path, a second simulator's check)
+#: unless TS_NVEC is set.  Keeps make test within its time budget on 2 cores.
+ICARUS_NVEC = 2500
+ICARUS_NVEC_MODULES = ("ts_quat_mul", "ts_quat_rotate", "ts_sincos", "ts_joint_quat", "ts_screw_transport",
+                       "ts_round_sat", "ts_mul", "ts_delay", "ts_resize")
+
+
 def run_bench(*, toplevel: str, test_file: str, sources: list[str], parameters: dict, sim: str,
               build_name: str, env: dict | None = None, includes: list[str] | None = None) -> None:
     """Build and run the cocotb bench in ``test_file`` (its own module) on ``toplevel``."""
@@ -107,6 +115,8 @@ def run_bench(*, toplevel: str, test_file: str, sources: list[str], parameters: 
     sim_build = BUILD / Path(test_dir).name / build_name
     extra = dict(env or {})
     extra.setdefault("TS_SEED", str(fresh_seed()))
+    if sim == "icarus" and toplevel in ICARUS_NVEC_MODULES and "TS_NVEC" not in os.environ:
+        extra.setdefault("TS_NVEC", str(ICARUS_NVEC))
     print(f"[{toplevel} {build_name}] TS_SEED={extra['TS_SEED']}")
     kw = {}
     if sim == "verilator":
