@@ -1,6 +1,7 @@
 """The FuseSoC package (tensor-servo.core): every target runs through fusesoc and does its job.
 
-lint / lint_regs: verilator --lint-only -Wall through edalize; sim / sim_compact: the self-checking
+lint / lint_core / lint_regs: verilator --lint-only -Wall through edalize (a primitive, the whole
+core, the register block); sim / sim_compact: the self-checking
 golden-vector bench of ts_quat_mul in Icarus (tb/fusesoc/tb_ts_quat_mul_golden.v) prints PASS; the
 same bench stops with a non-zero exit on a corrupted expected word; synth: yosys synth_ecp5 maps the
 compact quaternion product to at most 16 MULT18X18D (the issue's goal)."""
@@ -23,7 +24,7 @@ def fusesoc(target: str, build_root: Path) -> subprocess.CompletedProcess:
                            "--target", target, VLNV], cwd=ROOT, capture_output=True, text=True, timeout=900)
 
 
-@pytest.mark.parametrize("target", ["lint", "lint_regs"])
+@pytest.mark.parametrize("target", ["lint", "lint_core", "lint_regs"])
 def test_lint_targets(target, tmp_path):
     p = fusesoc(target, tmp_path)
     assert p.returncode == 0, p.stdout[-3000:] + p.stderr[-3000:]
