@@ -14,6 +14,8 @@ PY      := $(VENV)/bin/python
 PIP     := $(VENV)/bin/pip
 BUILD   := build
 JOBS    ?= $(shell nproc 2>/dev/null || echo 2)
+# Build the C++ objects in parallel too (every rule orders itself after the set-up stamps).
+MAKEFLAGS += -j$(JOBS)
 
 CXX      ?= g++
 CXXSTD   := -std=c++17
