@@ -300,6 +300,10 @@ model's formats (`tb/rtlparams.py`, `tensor_servo._model.formats`).
   decomposes >25x18 products); LUT = LUT1..LUT6, FF = FD*E, SRL = SRL16E/SRLC32E, BRAM18 = RAMB18E1 +
   2 RAMB36E1. Counts only (no open place-and-route for 7-series).
 - Latency in clock cycles (documented per module in `docs/rtl/`, checked by the benches).
+- The servo core (`ts_servo_core`, `--modules ts_servo_core`) is not in this table yet: its engines
+  instantiate separate quaternion units (over the MULT18X18D budget of LFE5U-85F in the default
+  configuration and of LFE5U-45F in the compact one) and no place-and-route of it has been run.
+  Cycles per tick, measured in simulation: `docs/rtl/ts_servo_core.md`.
 
 {table}
 
