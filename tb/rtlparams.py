@@ -330,3 +330,45 @@ if __name__ == "__main__":
             print(f"{top}\t{' '.join(files)}\t{ps}")
     else:
         sys.exit("usage: rtlparams.py lint-jobs")
+
+
+# ---- the engines' copies of the model's formats ------------------------------------------------------
+# ts_core_fk / ts_core_law / ts_core_solve write the widths they need as localparams
+# `TS_<FORMAT>_W/F = (CONFIG == 0) ? default : compact` and port widths as parameters of the same form;
+# their benches check every copy against the model with this function.
+def module_localparams(module: str, cfg: str) -> dict[str, int]:
+    """The TS_* localparams of rtl/<module>.v evaluated for a configuration."""
+    import re
+    ci = CONFIGS.index(cfg)
+    out = {}
+    for line in (RTL / f"{module}.v").read_text().splitlines():
+        m = re.match(r"\s*localparam (TS_\w+) = \(CONFIG == 0\) \? (\d+) : (\d+);", line)
+        if m:
+            out[m.group(1)] = int(m.group(2 + ci))
+            continue
+        m = re.match(r"\s*localparam (TS_\w+) = (\d+);", line)
+        if m:
+            out[m.group(1)] = int(m.group(2))
+    return out
+
+
+def check_module_formats(module: str, cfg: str, min_count: int, table_key: str,
+                         port_params: list[tuple[str, str]]) -> None:
+    """Assert that every TS_<FORMAT>_W/_F localparam of rtl/<module>.v (and TS_<table_key>, a table
+    size) and the default of every port-width parameter (name, format) equal the model's formats."""
+    import re
+    lp = module_localparams(module, cfg)
+    assert len(lp) > min_count, (module, cfg, len(lp))
+    fm = formats(cfg)
+    for key, val in lp.items():
+        if key == f"TS_{table_key}":
+            assert val == int(fm[table_key]), key
+            continue
+        name, suf = key[3:-2].lower() + "_t", key[-1]
+        w, f = fmt(cfg, name)
+        assert val == (w if suf == "W" else f), (cfg, key, val, w, f)
+    text = (RTL / f"{module}.v").read_text()
+    ci = CONFIGS.index(cfg)
+    for par, name in port_params:
+        m = re.search(rf"parameter {par} = \(CONFIG == 0\) \? (\d+) : (\d+)", text)
+        assert m and int(m.group(1 + ci)) == fmt(cfg, name)[0], (cfg, par)

@@ -76,40 +76,14 @@ def cfg_words(c: dict) -> list[tuple[int, int]]:
     return words
 
 
-def module_localparams(cfg: str) -> dict[str, int]:
-    """The TS_* localparams of rtl/ts_core_fk.v evaluated for a configuration."""
-    ci = 0 if cfg == "default" else 1
-    out = {}
-    for line in (rtlparams.RTL / f"{MODULE}.v").read_text().splitlines():
-        m = re.match(r"\s*localparam (TS_\w+) = \(CONFIG == 0\) \? (\d+) : (\d+);", line)
-        if m:
-            out[m.group(1)] = int(m.group(2 + ci))
-            continue
-        m = re.match(r"\s*localparam (TS_\w+) = (\d+);", line)
-        if m:
-            out[m.group(1)] = int(m.group(2))
-    return out
-
-
 def test_ts_core_fk_formats():
     """The module's format localparams (and port-width parameter defaults) equal the model's."""
     text = (rtlparams.RTL / f"{MODULE}.v").read_text()
     for cfg in tsbench.CONFIGS:
-        lp = module_localparams(cfg)
-        assert len(lp) > 20
-        fm = rtlparams.formats(cfg)
-        for key, val in lp.items():
-            if key == "TS_TRIG_TABLE_BITS":
-                assert val == int(fm["TRIG_TABLE_BITS"]), key
-                continue
-            name, suf = key[3:-2].lower() + "_t", key[-1]
-            w, f = rtlparams.fmt(cfg, name)
-            assert val == (w if suf == "W" else f), (cfg, key, val, w, f)
+        rtlparams.check_module_formats(MODULE, cfg, 20, "TRIG_TABLE_BITS",
+                                       [("ANG_W", "angle_t"), ("Q_W", "quat_t"), ("P_W", "pos_t"),
+                                        ("JW_W", "jw_t"), ("JV_W", "jv_t")])
         ci = 0 if cfg == "default" else 1
-        for par, name in (("ANG_W", "angle_t"), ("Q_W", "quat_t"), ("P_W", "pos_t"), ("JW_W", "jw_t"),
-                          ("JV_W", "jv_t")):
-            m = re.search(rf"parameter {par} = \(CONFIG == 0\) \? (\d+) : (\d+)", text)
-            assert m and int(m.group(1 + ci)) == rtlparams.fmt(cfg, name)[0], (cfg, par)
         sc = rtlparams.sincos(cfg)
         m = re.search(r"localparam TWOPI = \(CONFIG == 0\) \? (\d+) : (\d+);", text)
         assert int(m.group(1 + ci)) == sc["TWOPI"]

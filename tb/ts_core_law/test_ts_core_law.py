@@ -19,7 +19,6 @@ cycle count (logged, constant), the module's format localparams against the mode
 import json
 import math
 import os
-import re
 
 import numpy as np
 import pytest
@@ -38,39 +37,12 @@ except ImportError:  # pragma: no cover
     cocotb = None
 
 
-def module_localparams(cfg: str) -> dict[str, int]:
-    ci = 0 if cfg == "default" else 1
-    out = {}
-    for line in (rtlparams.RTL / f"{MODULE}.v").read_text().splitlines():
-        m = re.match(r"\s*localparam (TS_\w+) = \(CONFIG == 0\) \? (\d+) : (\d+);", line)
-        if m:
-            out[m.group(1)] = int(m.group(2 + ci))
-            continue
-        m = re.match(r"\s*localparam (TS_\w+) = (\d+);", line)
-        if m:
-            out[m.group(1)] = int(m.group(2))
-    return out
-
-
 def test_ts_core_law_formats():
     """The module's format localparams and port-width defaults equal the model's formats."""
-    text = (rtlparams.RTL / f"{MODULE}.v").read_text()
     for cfg in tsbench.CONFIGS:
-        lp = module_localparams(cfg)
-        assert len(lp) > 15
-        fm = rtlparams.formats(cfg)
-        for key, val in lp.items():
-            if key == "TS_ROTVEC_TABLE_BITS":
-                assert val == int(fm["ROTVEC_TABLE_BITS"]), key
-                continue
-            name, suf = key[3:-2].lower() + "_t", key[-1]
-            w, f = rtlparams.fmt(cfg, name)
-            assert val == (w if suf == "W" else f), (cfg, key, val, w, f)
-        ci = 0 if cfg == "default" else 1
-        for par, name in (("Q_W", "quat_t"), ("P_W", "pos_t"), ("V_W", "vel_t"), ("G_W", "gain_t"),
-                          ("PE_W", "perr_t"), ("RO_W", "rot_t"), ("JW_W", "jw_t"), ("JV_W", "jv_t")):
-            m = re.search(rf"parameter {par} = \(CONFIG == 0\) \? (\d+) : (\d+)", text)
-            assert m and int(m.group(1 + ci)) == rtlparams.fmt(cfg, name)[0], (cfg, par)
+        rtlparams.check_module_formats(MODULE, cfg, 15, "ROTVEC_TABLE_BITS",
+                                       [("Q_W", "quat_t"), ("P_W", "pos_t"), ("V_W", "vel_t"), ("G_W", "gain_t"),
+                                        ("PE_W", "perr_t"), ("RO_W", "rot_t"), ("JW_W", "jw_t"), ("JV_W", "jv_t")])
 
 
 # ---- cases (pure Python: model calls and the random setpoints) ------------------------------------

@@ -35,34 +35,13 @@ except ImportError:  # pragma: no cover
     cocotb = None
 
 
-def module_localparams(cfg: str) -> dict[str, int]:
-    ci = 0 if cfg == "default" else 1
-    out = {}
-    for line in (rtlparams.RTL / f"{MODULE}.v").read_text().splitlines():
-        m = re.match(r"\s*localparam (TS_\w+) = \(CONFIG == 0\) \? (\d+) : (\d+);", line)
-        if m:
-            out[m.group(1)] = int(m.group(2 + ci))
-    return out
-
-
 def test_ts_core_solve_formats():
     """The module's format localparams and port-width parameter defaults equal the model's formats."""
     text = (rtlparams.RTL / f"{MODULE}.v").read_text()
     for cfg in tsbench.CONFIGS:
-        lp = module_localparams(cfg)
-        assert len(lp) > 30
-        fm = rtlparams.formats(cfg)
-        for key, val in lp.items():
-            if key == "TS_RECIP_TABLE_BITS":
-                assert val == int(fm["RECIP_TABLE_BITS"]), key
-                continue
-            name, suf = key[3:-2].lower() + "_t", key[-1]
-            w, f = rtlparams.fmt(cfg, name)
-            assert val == (w if suf == "W" else f), (cfg, key, val, w, f)
+        rtlparams.check_module_formats(MODULE, cfg, 30, "RECIP_TABLE_BITS",
+                                       [("ANG_W", "angle_t"), ("QD_W", "qd_t"), ("TW_W", "tw_t")])
         ci = 0 if cfg == "default" else 1
-        for par, name in (("ANG_W", "angle_t"), ("QD_W", "qd_t"), ("TW_W", "tw_t")):
-            m = re.search(rf"parameter {par} = \(CONFIG == 0\) \? (\d+) : (\d+)", text)
-            assert m and int(m.group(1 + ci)) == rtlparams.fmt(cfg, name)[0], (cfg, par)
         m = re.search(r"parameter CD_W = \(CONFIG == 0\) \? (\d+) : (\d+)", text)
         widest = max(rtlparams.fmt(cfg, n)[0] for n in ("angle_t", "qd_t", "jw_t", "jv_t", "vel_t", "lchar_t",
                                                          "klim_t", "dt_t", "mu_t"))
