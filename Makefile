@@ -6,6 +6,7 @@
 #   make golden  regenerate tb/golden/ from the model
 #   make synth   ECP5 / 7-series resources and post-route Fmax of the RTL (docs/resources.md)
 #   make lint    verilator -Wall and iverilog on every RTL parameter set; HLS kernel checks
+#   make soak    the Verilated core against the model, 10,000 ticks per chain and configuration
 SHELL := /bin/bash
 .DEFAULT_GOAL := help
 
@@ -28,10 +29,10 @@ PKG      := model/python/tensor_servo
 STAMP_APT  := $(BUILD)/.apt.stamp
 STAMP_VENV := $(VENV)/.stamp
 
-.PHONY: help setup build test test-cpp test-py demo bench golden lint lint-rtl synth clean distclean hls-csim hls-lint hls-tables regs regs-check regs-html
+.PHONY: help setup build test test-cpp test-py demo soak bench golden lint lint-rtl synth clean distclean hls-csim hls-lint hls-tables regs regs-check regs-html
 
 help:
-	@sed -n '2,8p' Makefile | sed 's/^# //'
+	@sed -n '2,9p' Makefile | sed 's/^# //'
 
 # ---- set-up ------------------------------------------------------------------------------------
 $(STAMP_APT): scripts/setup_system.sh
@@ -106,6 +107,12 @@ test-py: build
 # ---- the main job --------------------------------------------------------------------------------
 demo: setup
 	$(PY) -m tensor_servo.demo
+
+# tb/test_rtl_track.py at length: every chain in closed loop through the Verilated core, 10,000
+# ticks at 2 sweeps, both configurations, compared tick by tick with the model (~15 min on 2 cores).
+SOAK_TICKS ?= 10000
+soak: setup
+	TS_RTL_TICKS=$(SOAK_TICKS) TS_RTL_SWEEPS=2 $(PY) -m pytest -n $(JOBS) -q -rA tb/test_rtl_track.py -k bit_identical
 
 bench: setup
 	$(PY) scripts/bench.py

@@ -28,6 +28,9 @@ struct ServoBase {
   virtual py::dict ik(const f64arr& q0, const f64arr& tq, const f64arr& tp, int max_ticks, double tol_pos,
                       double tol_rot) const = 0;
   virtual py::dict params_raw() const = 0;
+  virtual py::dict inputs_raw(const py::array& q, const py::array& uq, const py::array& up, const py::array& uw,
+                              const py::array& uv, const py::array& qd_warm) const = 0;
+  virtual py::dict config_raw() const = 0;
   virtual py::dict solve_raw(const i64arr& J, const i64arr& V, const i64arr& q, const i64arr& warm) const = 0;
 };
 
@@ -135,16 +138,16 @@ struct Servo final : ServoBase {
   }
 
   // U arrays: (T,4), (T,3), (T,3), (T,3) for T = ntasks setpoints.
-  py::dict tick(const py::array& q_in, const py::array& uq_in, const py::array& up_in, const py::array& uw_in,
-                const py::array& uv_in, const py::array& w_in, bool raw) const override {
+  // A tick's inputs in the model's formats (float inputs quantised as the tick does; the status
+  // collects the quantisation flags, which the tick reports with its own).
+  void load_inputs(const py::array& q_in, const py::array& uq_in, const py::array& up_in, const py::array& uw_in,
+                   const py::array& uv_in, const py::array& w_in, bool raw, angle_t* qq, Setpoint<Fmt>* U,
+                   qd_t* warm, Status& st) const {
     const int n = ch.n, T = P.ntasks;
     const py::array q = as(q_in, raw), uq = as(uq_in, raw), up = as(up_in, raw), uw = as(uw_in, raw),
                     uv = as(uv_in, raw), w = as(w_in, raw);
     need_shape(q, {n}, "q"); need_shape(uq, {T, 4}, "U_quat"); need_shape(up, {T, 3}, "U_pos");
     need_shape(uw, {T, 3}, "U_w"); need_shape(uv, {T, 3}, "U_v"); need_shape(w, {n}, "qd_warm");
-    angle_t qq[NMAX]; qd_t warm[NMAX];
-    Setpoint<Fmt> U[4];
-    Status st;
     for (int i = 0; i < n; ++i)
       qq[i] = raw ? of_raw<angle_t>(static_cast<const int64_t*>(q.data())[i])
                   : from_double<angle_t>(static_cast<const double*>(q.data())[i], st);
@@ -157,6 +160,15 @@ struct Servo final : ServoBase {
     for (int i = 0; i < n; ++i)
       warm[i] = raw ? of_raw<qd_t>(static_cast<const int64_t*>(w.data())[i])
                     : from_double<qd_t>(static_cast<const double*>(w.data())[i], st);
+  }
+
+  py::dict tick(const py::array& q_in, const py::array& uq_in, const py::array& up_in, const py::array& uw_in,
+                const py::array& uv_in, const py::array& w_in, bool raw) const override {
+    const int n = ch.n, T = P.ntasks;
+    angle_t qq[NMAX]; qd_t warm[NMAX];
+    Setpoint<Fmt> U[4];
+    Status st;
+    load_inputs(q_in, uq_in, up_in, uw_in, uv_in, w_in, raw, qq, U, warm, st);
     auto R = std::make_unique<TickResult<Fmt, NMAX>>();
     servo_tick(ch, P, qq, U, warm, *R, st);
     f64arr qd(shp(n)), qn(shp(n)), ep(shp(T, 3)), eo(shp(T, 3)), r(shp(6 * T));
@@ -262,6 +274,65 @@ struct Servo final : ServoBase {
     }
   }
 
+  // The raw words tick() would use for float inputs: q, U (one task), warm start, and the flags the
+  // quantisation raised (the servo core's input packet is these words).
+  py::dict inputs_raw(const py::array& q, const py::array& uq, const py::array& up, const py::array& uw,
+                      const py::array& uv, const py::array& w) const override {
+    if constexpr (Fmt::is_float) { throw std::invalid_argument("inputs_raw needs a fixed-point configuration"); }
+    else {
+      const int n = ch.n, T = P.ntasks;
+      angle_t qq[NMAX]; qd_t warm[NMAX];
+      Setpoint<Fmt> U[4];
+      Status st;
+      load_inputs(q, uq, up, uw, uv, w, false, qq, U, warm, st);
+      i64arr q_r(shp(n)), w_r(shp(n)), uq_r(shp(T, 4)), up_r(shp(T, 3)), uw_r(shp(T, 3)), uv_r(shp(T, 3));
+      for (int i = 0; i < n; ++i) { q_r.mutable_at(i) = raw_of(qq[i]); w_r.mutable_at(i) = raw_of(warm[i]); }
+      for (int t = 0; t < T; ++t) {
+        for (int a = 0; a < 4; ++a) uq_r.mutable_at(t, a) = raw_of(U[t].Q.c[a]);
+        for (int a = 0; a < 3; ++a) {
+          up_r.mutable_at(t, a) = raw_of(U[t].p.c[a]);
+          uw_r.mutable_at(t, a) = raw_of(U[t].w.c[a]);
+          uv_r.mutable_at(t, a) = raw_of(U[t].v.c[a]);
+        }
+      }
+      return py::dict("q"_a = q_r, "uq"_a = uq_r, "up"_a = up_r, "uw"_a = uw_r, "uv"_a = uv_r, "warm"_a = w_r,
+                      "flags"_a = st.flags);
+    }
+  }
+
+  // The servo core's register words (commit_raw's input, core_config.hpp RawConfig) of this
+  // servo: the quantised chain constants and parameters, so that the core commits exactly the
+  // state this servo ticks with.  Serial chain, one task (the tool), setpoint in the root frame,
+  // as the core supports.
+  py::dict config_raw() const override {
+    if constexpr (Fmt::is_float) { throw std::invalid_argument("config_raw needs a fixed-point configuration"); }
+    else {
+      const int n = ch.n;
+      for (int i = 0; i < n; ++i)
+        if (ch.parent[i] != i) throw std::invalid_argument("chain: a tree of chains (the core takes serial chains)");
+      if (ch.ntips != 1 || P.ntasks != 1 || P.controlled[0] != -1)
+        throw std::invalid_argument("controlled: the core controls the tool of a serial chain (one task)");
+      if (P.setpoint_frame != -1) throw std::invalid_argument("setpoint_frame: the core takes setpoints in the root frame");
+      auto v = [](const auto* c, int k) { std::vector<int64_t> o; for (int a = 0; a < k; ++a) o.push_back(raw_of(c[a])); return o; };
+      py::list joints;
+      for (int i = 0; i < n; ++i) {
+        const JointQ<Fmt>& j = ch.j[i];
+        const bool vlim = !(P.solver.vmax[i] == max_of<qd_t>());
+        const uint32_t jcfg = (j.prismatic ? JCFG_PRISMATIC : 0u) | (P.solver.limited[i] ? JCFG_LIMITED : 0u) |
+                              (vlim ? JCFG_VLIMITED : 0u);
+        joints.append(py::dict("jcfg"_a = jcfg, "qo"_a = v(j.qo.c, 4), "po"_a = v(j.po.c, 3), "axis"_a = v(j.axis.c, 3),
+                               "scale"_a = raw_of(j.s), "lower"_a = raw_of(P.solver.lo[i]), "upper"_a = raw_of(P.solver.hi[i]),
+                               "vmax"_a = vlim ? raw_of(P.solver.vmax[i]) : 0, "mu"_a = raw_of(P.solver.mu[i])));
+      }
+      const uint32_t mode = (P.mode == ERR_B ? MODE_ERR_B : 0u) | (P.feedforward ? 0u : MODE_ERROR_ONLY);
+      return py::dict("n"_a = n, "mode"_a = mode, "sweeps"_a = P.solver.sweeps, "warm_leak"_a = P.warm_leak,
+                      "kp"_a = raw_of(P.kp), "ko"_a = raw_of(P.ko), "lchar"_a = raw_of(P.solver.L),
+                      "klim"_a = raw_of(P.solver.klim), "dt"_a = raw_of(P.dt), "base_q"_a = v(ch.qb.c, 4),
+                      "base_p"_a = v(ch.pb.c, 3), "tool_q"_a = v(ch.qt[0].c, 4), "tool_p"_a = v(ch.pt[0].c, 3),
+                      "joints"_a = joints);
+    }
+  }
+
   py::dict params_raw() const override {
     const int n = ch.n;
     i64arr mu(shp(n)), lo(shp(n)), hi(shp(n)), vmax(shp(n));
@@ -353,6 +424,9 @@ void bind_servo(py::module_& m) {
       .def("ik", &ServoBase::ik, py::arg("q0"), py::arg("T_quat"), py::arg("T_pos"), py::arg("max_ticks"),
            py::arg("tol_pos"), py::arg("tol_rot"))
       .def("params_raw", &ServoBase::params_raw)
+      .def("inputs_raw", &ServoBase::inputs_raw, py::arg("q"), py::arg("U_quat"), py::arg("U_pos"), py::arg("U_w"),
+           py::arg("U_v"), py::arg("qd_warm"))
+      .def("config_raw", &ServoBase::config_raw)
       .def("solve_raw", &ServoBase::solve_raw, py::arg("J"), py::arg("V"), py::arg("q"), py::arg("warm"));
   m.def("commit_raw", [](const std::string& cfg, const py::dict& raw, int core_nmax) -> py::tuple {
     if (core_nmax < 1 || core_nmax > NMAX) throw std::invalid_argument("core_nmax: 1..64");

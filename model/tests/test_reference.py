@@ -12,6 +12,7 @@ import pytest
 from tensor_servo import reference as ref
 from tensor_servo.chain import Chain, Joint, Limits, Pose
 from tensor_servo.oracle import PinChain
+from tensor_servo.randchain import random_chain
 
 TOL_PIN = 1e-12     # absolute, against Pinocchio (lengths ~ 1 m)
 TOL_FD = 1e-7       # absolute, against central finite differences
@@ -41,29 +42,6 @@ def _record(key: str, err: float) -> float:
 
 
 # ---- random chains --------------------------------------------------------------------------
-
-def _unit(rng, n):
-    v = rng.normal(size=n)
-    return v / np.linalg.norm(v)
-
-
-def _rand_pose(rng, lo=0.05, hi=0.5):
-    return Pose(_unit(rng, 3) * rng.uniform(lo, hi), _unit(rng, 4))
-
-
-def random_chain(rng, n: int) -> Chain:
-    """Random unit-quaternion origins, random axes, offsets 0.05-0.5 m, ~1/3 prismatic joints,
-    non-identity base and tool, non-unit (also negative / degree-like) scales on some joints."""
-    joints = []
-    for i in range(n):
-        prismatic = rng.random() < 0.35
-        u = rng.random()
-        scale = 1.0 if u < 0.4 else (math.pi / 180 if u < 0.6 else float(rng.choice([-1, 1]) * rng.uniform(0.2, 3.0)))
-        reach = 0.5 if prismatic else math.pi          # range of scale*q
-        lim = Limits(-reach / abs(scale), reach / abs(scale))
-        joints.append(Joint(f"j{i}", "prismatic" if prismatic else "revolute", _rand_pose(rng), _unit(rng, 3), lim, scale))
-    return Chain(f"rand{n}", joints, _rand_pose(rng, 0.1, 1.0), _rand_pose(rng))
-
 
 def _chains(seed: int, sizes) -> list[Chain]:
     rng = np.random.default_rng(seed)

@@ -121,6 +121,7 @@ if os.environ.get("COCOTB_SIM") or os.environ.get("TOPLEVEL"):
     import logging
 
     from tensor_servo import _model, regs, robots
+    from tensor_servo.rtl_core import register_writes
 
     class TB:
         def __init__(self, dut):
@@ -170,27 +171,8 @@ if os.environ.get("COCOTB_SIM") or os.environ.get("TOPLEVEL"):
             return await self.axil.read_dword(addr)
 
         async def configure(self, raw: dict):
-            await self.wr(regs.NJOINTS, raw["n"])
-            mode = raw["mode"] | (raw["sweeps"] << regs.MODE_SWEEPS_SHIFT) | (raw["warm_leak"] << regs.MODE_WARM_LEAK_SHIFT)
-            await self.wr(regs.MODE, mode)
-            for k in ("kp", "ko", "lchar", "klim", "dt"):
-                await self.wr(getattr(regs, k.upper()), raw[k])
-            for i, c in enumerate("WXYZ"):
-                await self.wr(getattr(regs, "BASE_Q" + c), raw["base_q"][i])
-                await self.wr(getattr(regs, "TOOL_Q" + c), raw["tool_q"][i])
-            for i, c in enumerate("XYZ"):
-                await self.wr(getattr(regs, "BASE_P" + c), raw["base_p"][i])
-                await self.wr(getattr(regs, "TOOL_P" + c), raw["tool_p"][i])
-            for j, jd in enumerate(raw["joints"][:NMAX]):
-                a = lambda f: regs.joint_addr(j, f)  # noqa: E731
-                await self.wr(a("JCFG"), jd["jcfg"])
-                for i, c in enumerate("WXYZ"):
-                    await self.wr(a("ORIGIN_Q" + c), jd["qo"][i])
-                for i, c in enumerate("XYZ"):
-                    await self.wr(a("ORIGIN_P" + c), jd["po"][i])
-                    await self.wr(a("AXIS_" + c), jd["axis"][i])
-                for f in ("scale", "lower", "upper", "vmax", "mu"):
-                    await self.wr(a(f.upper()), jd[f])
+            for addr, word in register_writes(raw, NMAX):
+                await self.wr(addr, word)
 
         async def commit(self, ctrl_after: int):
             await self.wr(regs.CTRL, regs.CTRL_COMMIT)

@@ -1,6 +1,6 @@
 """``tservo track`` (closed-loop tracking with a simulated plant) and ``tservo path`` (point arrays).
 
-    tservo track CHAIN.json --path PATH.npz --q0 Q0.npy [--model float|fixed] [--config default|compact]
+    tservo track CHAIN.json --path PATH.npz --q0 Q0.npy [--model float|fixed|rtl] [--config default|compact]
                  [--mode A|B] [--error-only] [--kp K] [--ko K] [--kdt X] [--klim K] [--L M] [--sweeps N]
                  [--mu MU[,MU...]] [--warm auto|prev|zero|S] [--no-vlimits] [--setpoint-frame K]
                  [--lag TAU] [--counts C] -o OUT.npz
@@ -41,10 +41,12 @@ from .arrays import check_shape, load_array, save_npz
 from .errors import InputError
 
 
-def _add_model(p: argparse.ArgumentParser) -> None:
+def _add_model(p: argparse.ArgumentParser, rtl: bool = False) -> None:
     from .track import model_names
 
-    p.add_argument("--model", choices=model_names(), default="fixed", help="float (C++ double) or fixed point")
+    names = model_names() if rtl else tuple(m for m in model_names() if m != "rtl")
+    p.add_argument("--model", choices=names, default="fixed",
+                   help="float (C++ double), fixed point" + (", or rtl (the Verilated servo core)" if rtl else ""))
     p.add_argument("--config", choices=("default", "compact"), default="default", help="fixed-point configuration")
 
 
@@ -53,7 +55,7 @@ def register(sub) -> None:
     p.add_argument("chain", help="chain JSON file or embedded example name")
     p.add_argument("--path", required=True, help="setpoints: .npz with T (K,4,4), V (K,6), dt")
     p.add_argument("--q0", required=True, help="initial joint values, .npy (n,)")
-    _add_model(p)
+    _add_model(p, rtl=True)
     p.add_argument("--mode", choices=("A", "B"), default="A", help="error choice A (root basis) or B (body basis)")
     p.add_argument("--error-only", action="store_true", help="no feed-forward of the setpoint twist")
     p.add_argument("--kp", type=float, help="position gain (1/s)")

@@ -13,9 +13,10 @@ tool relative to frame k, ``T_k(q)^-1 T_tool(q)``.  ``flags[k]`` are the status 
 during tick k (``tensor_servo.model.STATUS_BITS``; OR them for the whole run).
 
 Models are pluggable: :func:`make_tick` looks the name up in ``MODEL_FACTORIES`` (``float``: the C++
-model instantiated on double; ``fixed``: bit-accurate, ``config`` default|compact); a later RTL
-back end registers itself with :func:`register_model` and must return a callable with the same
-contract: ``tick(q_meas, U (4,4), V (6,), qd_warm (n,)) -> object with .qd (n,) and .flags``.
+model instantiated on double; ``fixed``: bit-accurate, ``config`` default|compact; ``rtl``: the
+Verilated servo core, rtl_core.RtlServo, bit-identical to ``fixed``); further back ends register
+themselves with :func:`register_model` and must return a callable with the same contract:
+``tick(q_meas, U (4,4), V (6,), qd_warm (n,)) -> object with .qd (n,) and .flags``.
 """
 from __future__ import annotations
 
@@ -52,6 +53,8 @@ class TickModel:
     ranges: dict = field(default_factory=dict)   # 'angle', 'pos', 'vel', 'gain', 'klim', 'qd', 'dt': |x| < value
     dt_lsb: float | None = None                  # LSB of the tick-period format (None: float)
     qd_lsb: float | None = None                  # LSB of the joint-rate format (None: float)
+    set_warm: Callable | None = None             # told the loop's warm-start policy (a core keeping its own)
+    core: object | None = None                   # the back end object (rtl: RtlServo, .cycles per tick)
 
     def __call__(self, q, U, V, qd_warm):
         return self.fn(q, U, V, qd_warm)
@@ -83,9 +86,19 @@ def _servo_factory(cpp_config: str | None):
     return make
 
 
+def _rtl_factory(chain: Chain, config: str, dt: float, params: dict) -> TickModel:
+    """The Verilated servo core (rtl_core.RtlServo): bit-identical to ``fixed``."""
+    from .rtl_core import RtlServo
+
+    core = RtlServo(chain, config, dt=dt, **params)
+    ranges, dt_lsb, qd_lsb = format_ranges(config)
+    return TickModel(core.tick, "rtl", config, ranges, dt_lsb, qd_lsb, set_warm=core.set_warm, core=core)
+
+
 MODEL_FACTORIES: dict[str, Callable[..., TickModel]] = {
     "float": _servo_factory("double"),
     "fixed": _servo_factory(None),
+    "rtl": _rtl_factory,
 }
 
 
@@ -307,6 +320,8 @@ def track(chain: Chain, T: np.ndarray, V: np.ndarray, q0: np.ndarray, tick: Call
     if isinstance(warm, str) and warm == "auto":
         warm = leak_shift(plant.dt)
     warm_start(np.zeros(n), warm, qd_lsb)  # validates the policy before the run
+    if getattr(tick, "set_warm", None) is not None:
+        tick.set_warm(warm)
     plant.reset(q0)
     q[0] = plant.q
     w = np.zeros(n)
