@@ -1,5 +1,11 @@
 // tensor-servo: constant functions shared by the datapath modules (included inside module bodies).
 // Language: Verilog 2005
+//
+// Lint: Verilator 5.006 reports VARHIDDEN on these functions in one elaboration of the whole core with
+// TARGET "GENERIC" (the ts_quat_mul parameterisation that ts_core_fk and ts_core_law share: the
+// function of the instance "hides" the same function of an enclosing module).  Every copy is this
+// file's, so nothing is hidden that differs; the waiver covers this file only.
+/* verilator lint_off VARHIDDEN */
 
 // Latency of ts_mul in clock cycles for operand widths aw x bw, for every TARGET: 3 register
 // stages (input, product, output); with an operand wider than 18 bits one more for the fabric
@@ -28,3 +34,4 @@ function integer ts_round_lat;
     ts_round_lat = (sat >= 0) ? 2 : 2;
   end
 endfunction
+/* verilator lint_on VARHIDDEN */

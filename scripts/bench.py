@@ -10,6 +10,8 @@ Sections (each prints a table and, unless --no-write, rewrites its section of do
         (double, fixed) vs roboticstoolbox ik_LM, Pinocchio CLIK and ikpy (bench_ik.py; ~15 min)
   track steady tracking error of a circle and a figure-eight at 1 and 10 kHz, fixed vs float
         (bench_tracking.py)
+  core  the servo core's tick (cycles of the Verilated core at its post-route Fmax) vs the same tick
+        of the C++ model in double on one core of this machine (bench_tick.cpp)
 """
 from __future__ import annotations
 
@@ -28,6 +30,7 @@ sys.path.insert(0, str(ROOT / "model" / "python"))
 
 from tensor_servo import robots  # noqa: E402
 from tensor_servo.model import model_spec  # noqa: E402
+from tensor_servo.rtl_core import tick_cycles  # noqa: E402
 
 BUILD = ROOT / "build" / "bench"
 DOC = ROOT / "docs" / "benchmarks.md"
@@ -48,23 +51,29 @@ def pin_prefix() -> Path:
     return Path(sysconfig.get_paths()["purelib"]) / "cmeel.prefix"
 
 
-def build_bench_kin() -> Path:
-    exe = BUILD / "bench_kin"
-    src = ROOT / "model" / "bench" / "bench_kin.cpp"
-    hdrs = list((ROOT / "model" / "include" / "tensor_servo").glob("*.hpp"))
+def build_bench(name: str, pinocchio: bool) -> Path:
+    """Compile model/bench/<name>.cpp (-O3 -march=native) unless up to date."""
+    exe = BUILD / name
+    src = ROOT / "model" / "bench" / f"{name}.cpp"
+    hdrs = [*(ROOT / "model" / "include" / "tensor_servo").glob("*.hpp"), *(ROOT / "model" / "bench").glob("*.hpp")]
     if exe.exists() and all(exe.stat().st_mtime > p.stat().st_mtime for p in [src, *hdrs]):
         return exe
     BUILD.mkdir(parents=True, exist_ok=True)
-    # Pinocchio header-only (its templates instantiated here, -O3 -march=native like ours);
-    # the BOOST_MPL limits are the ones Pinocchio's CMake config exports.
-    cmd = ["g++", "-std=c++17", "-O3", "-march=native", "-DNDEBUG", "-w",
-           "-DBOOST_MPL_LIMIT_LIST_SIZE=30", "-DBOOST_MPL_LIMIT_VECTOR_SIZE=30",
-           "-DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS", "-DBOOST_FUSION_INVOKE_MAX_ARITY=12",
-           "-I/usr/include/eigen3", f"-I{pin_prefix() / 'include'}", f"-I{ROOT / 'model' / 'include'}",
-           str(src), "-o", str(exe)]
-    print("bench: compiling", exe.relative_to(ROOT), "(Pinocchio headers: about a minute)", flush=True)
-    subprocess.run(cmd, check=True)
+    cmd = ["g++", "-std=c++17", "-O3", "-march=native", "-DNDEBUG", "-w", "-I/usr/include/eigen3",
+           f"-I{ROOT / 'model' / 'include'}"]
+    if pinocchio:
+        # Pinocchio header-only (its templates instantiated here, -O3 -march=native like ours);
+        # the BOOST_MPL limits are the ones Pinocchio's CMake config exports.
+        cmd += ["-DBOOST_MPL_LIMIT_LIST_SIZE=30", "-DBOOST_MPL_LIMIT_VECTOR_SIZE=30",
+                "-DBOOST_MPL_CFG_NO_PREPROCESSED_HEADERS", "-DBOOST_FUSION_INVOKE_MAX_ARITY=12",
+                f"-I{pin_prefix() / 'include'}"]
+    print("bench: compiling", exe.relative_to(ROOT), "(Pinocchio headers: about a minute)" if pinocchio else "", flush=True)
+    subprocess.run(cmd + [str(src), "-o", str(exe)], check=True)
     return exe
+
+
+def build_bench_kin() -> Path:
+    return build_bench("bench_kin", pinocchio=True)
 
 
 def write_spec_txt(name: str, path: Path) -> None:
@@ -123,7 +132,66 @@ def bench_track_section(seconds: float) -> str:
     return bench_tracking()
 
 
-SECTIONS = {"kin": bench_kin, "ik": bench_ik_section, "track": bench_track_section}
+CORE_CHAINS = ["puma560", "panda"]     # 6 and 7 joints
+CORE_SWEEPS = 2
+CORE_GOAL_NS = 1000.0
+
+
+def core_fmax() -> dict:
+    """Post-route Fmax of the whole core per configuration from scripts/synth_core.py's results
+    (build/synth/core_results.json): {cfg: (MHz worst seed, device) or None}."""
+    import json
+
+    f = ROOT / "build" / "synth" / "core_results.json"
+    res = json.loads(f.read_text()) if f.exists() else {}
+    out = {}
+    for cfg in ("default", "compact"):
+        r = res.get(cfg)
+        out[cfg] = (min(r["fmax"]), r["device"]) if r and r.get("fmax") else None
+    return out
+
+
+def bench_core(seconds: float) -> str:
+    """The servo core's tick (cycles measured on the Verilated core in this run, at the post-route
+    Fmax of scripts/synth_core.py) against the same tick of the C++ model in double on one core."""
+    exe = build_bench("bench_tick", pinocchio=False)
+    fmax = core_fmax()
+    lines = [f"Tick: FK, Jacobian, servo law (A, feed-forward), {CORE_SWEEPS} descent sweeps. Core: cycles per tick "
+             "(TICK_CYCLES) of the Verilated core measured in this run, at the worst-seed post-route Fmax of the "
+             "whole core from `scripts/synth_core.py` (build/synth/core_results.json; not re-run by make bench). "
+             "Peer: `model/bench/bench_tick.cpp`, the model's `servo_tick` in double, -O3 -march=native, one core, "
+             "min / median ns over 7 repetitions.", "",
+             "| config | chain | joints | core cycles/tick | core Fmax | core ns/tick | C++ double ns/tick (min / median) "
+             "| core / double |", "|---|---|---|---|---|---|---|---|"]
+    verdict = []
+    for name in CORE_CHAINS:
+        spec = BUILD / f"{name}.txt"
+        write_spec_txt(name, spec)
+        out = subprocess.run([str(exe), str(spec), str(CORE_SWEEPS), str(seconds)], check=True, capture_output=True,
+                             text=True).stdout
+        t = {p[0]: (float(p[1]), float(p[2])) for p in (ln.split() for ln in out.splitlines()) if len(p) >= 3}
+        d_min, d_med = t["tick-double"]
+        n = robots.load(name).n
+        for cfg in ("default", "compact"):
+            c = tick_cycles(robots.load(name), cfg, CORE_SWEEPS)
+            fm = fmax[cfg]
+            if fm is None:
+                lines.append(f"| {cfg} | {name} | {n} | {c} | not placed | - | {d_min:.0f} / {d_med:.0f} | - |")
+                if n == 6:
+                    verdict.append(f"- Goal: 6-joint tick <= {CORE_GOAL_NS:.0f} ns in {cfg}: no post-route Fmax "
+                                   f"(see docs/resources.md); {c} cycles would need {c / CORE_GOAL_NS * 1e3:.0f} MHz.")
+                continue
+            ns = c / fm[0] * 1e3
+            lines.append(f"| {cfg} | {name} | {n} | {c} | {fm[0]:.1f} MHz ({fm[1]} -6) | {ns:.0f} | {d_min:.0f} / "
+                         f"{d_med:.0f} | {ns / d_min:.2f} |")
+            if n == 6:
+                verdict.append(f"- Goal: 6-joint tick <= {CORE_GOAL_NS:.0f} ns ({cfg}, {fm[1]}): {ns:.0f} ns -> "
+                               f"{'met' if ns <= CORE_GOAL_NS else 'MISSED'}; against double on this CPU: "
+                               f"{ns / d_min:.2f}x its time -> {'faster' if ns < d_min else 'slower'}.")
+    return "\n".join(lines) + "\n\n" + "\n".join(verdict)
+
+
+SECTIONS = {"kin": bench_kin, "ik": bench_ik_section, "track": bench_track_section, "core": bench_core}
 
 
 def replace_section(text: str, name: str, body: str) -> str:

