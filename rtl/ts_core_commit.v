@@ -367,6 +367,14 @@ module ts_core_commit #(
   endgenerate
 
   // ---- operand selection (issue side) -------------------------------------------------------------
+  wire [QUAT_W-1:0] i_qo0, i_qo1, i_qo2, i_qo3, i_ax0, i_ax1, i_ax2;
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq0 (.in_vec(sh_qo0), .in_idx(iss_j), .out_el(i_qo0));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq1 (.in_vec(sh_qo1), .in_idx(iss_j), .out_el(i_qo1));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq2 (.in_vec(sh_qo2), .in_idx(iss_j), .out_el(i_qo2));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq3 (.in_vec(sh_qo3), .in_idx(iss_j), .out_el(i_qo3));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_ia0 (.in_vec(sh_ax0), .in_idx(iss_j), .out_el(i_ax0));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_ia1 (.in_vec(sh_ax1), .in_idx(iss_j), .out_el(i_ax1));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_ia2 (.in_vec(sh_ax2), .in_idx(iss_j), .out_el(i_ax2));
   reg [QUAT_W-1:0] q_sel;
   always @* begin
     q_sel = sh_bq0;
@@ -383,18 +391,36 @@ module ts_core_commit #(
       endcase
     end else begin
       case (iss_k[2:0])
-        3'd0: q_sel = sh_qo0[iss_j*QUAT_W +: QUAT_W];
-        3'd1: q_sel = sh_qo1[iss_j*QUAT_W +: QUAT_W];
-        3'd2: q_sel = sh_qo2[iss_j*QUAT_W +: QUAT_W];
-        3'd3: q_sel = sh_qo3[iss_j*QUAT_W +: QUAT_W];
-        3'd4: q_sel = sh_ax0[iss_j*QUAT_W +: QUAT_W];
-        3'd5: q_sel = sh_ax1[iss_j*QUAT_W +: QUAT_W];
-        default: q_sel = sh_ax2[iss_j*QUAT_W +: QUAT_W];
+        3'd0: q_sel = i_qo0;
+        3'd1: q_sel = i_qo1;
+        3'd2: q_sel = i_qo2;
+        3'd3: q_sel = i_qo3;
+        3'd4: q_sel = i_ax0;
+        3'd5: q_sel = i_ax1;
+        default: q_sel = i_ax2;
       endcase
     end
   end
-  wire [SCALE_W-1:0] s_iss = sh_s[iss_j*SCALE_W +: SCALE_W];
-  wire [ANGLE_W-1:0] lim_iss = (iss_k == 4'd8) ? sh_lo[iss_j*ANGLE_W +: ANGLE_W] : sh_hi[iss_j*ANGLE_W +: ANGLE_W];
+  wire [SCALE_W-1:0] s_iss;
+  wire [ANGLE_W-1:0] i_lo, i_hi;
+  ts_sel #(.W(SCALE_W), .N(NMAX), .IW(JI_W)) u_sel_is (.in_vec(sh_s), .in_idx(iss_j), .out_el(s_iss));
+  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_ilo (.in_vec(sh_lo), .in_idx(iss_j), .out_el(i_lo));
+  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_ihi (.in_vec(sh_hi), .in_idx(iss_j), .out_el(i_hi));
+  wire [ANGLE_W-1:0] lim_iss = (iss_k == 4'd8) ? i_lo : i_hi;
+  // joint c_j's words as the consume stage takes them
+  wire [SCALE_W-1:0] cj_s;
+  wire [ANGLE_W-1:0] cj_lo, cj_hi;
+  wire [QD_W-1:0] cj_vmax;
+  wire [MU_W-1:0] cj_mu;
+  wire [LEN_W-1:0] cj_pox, cj_poy, cj_poz;
+  ts_sel #(.W(SCALE_W), .N(NMAX), .IW(JI_W)) u_sel_cs (.in_vec(sh_s), .in_idx(c_j), .out_el(cj_s));
+  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_clo (.in_vec(sh_lo), .in_idx(c_j), .out_el(cj_lo));
+  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_chi (.in_vec(sh_hi), .in_idx(c_j), .out_el(cj_hi));
+  ts_sel #(.W(QD_W), .N(NMAX), .IW(JI_W)) u_sel_cvm (.in_vec(sh_vmax), .in_idx(c_j), .out_el(cj_vmax));
+  ts_sel #(.W(MU_W), .N(NMAX), .IW(JI_W)) u_sel_cmu (.in_vec(sh_mu), .in_idx(c_j), .out_el(cj_mu));
+  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_cpx (.in_vec(sh_pox), .in_idx(c_j), .out_el(cj_pox));
+  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_cpy (.in_vec(sh_poy), .in_idx(c_j), .out_el(cj_poy));
+  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_cpz (.in_vec(sh_poz), .in_idx(c_j), .out_el(cj_poz));
   wire [RB-1:0] reach_op = {1'b0, reach[RB-2:0]};
 
   wire signed [MA_W-1:0] qa, sa, ma;
@@ -507,6 +533,7 @@ module ts_core_commit #(
     end
   endtask
 
+  integer ki;
   always @(posedge clk) begin
     if (rst) begin
       state <= S_IDLE;
@@ -715,12 +742,12 @@ module ts_core_commit #(
                 cur_pris <= sh_pris[c_j];
                 cur_lim <= sh_lim[c_j];
                 cur_vlim <= sh_vlim[c_j];
-                cur_s <= sh_s[c_j*SCALE_W +: SCALE_W];
-                cur_lo <= sh_lo[c_j*ANGLE_W +: ANGLE_W];
-                cur_hi <= sh_hi[c_j*ANGLE_W +: ANGLE_W];
-                cur_vmax <= sh_vmax[c_j*QD_W +: QD_W];
-                cur_mu <= sh_mu[c_j*MU_W +: MU_W];
-                cur_l1 <= l1(sh_pox[c_j*LEN_W +: LEN_W], sh_poy[c_j*LEN_W +: LEN_W], sh_poz[c_j*LEN_W +: LEN_W]);
+                cur_s <= cj_s;
+                cur_lo <= cj_lo;
+                cur_hi <= cj_hi;
+                cur_vmax <= cj_vmax;
+                cur_mu <= cj_mu;
+                cur_l1 <= l1(cj_pox, cj_poy, cj_poz);
               end
               if (c_k <= 4'd6) acc <= acc_next;
               if (c_k == 4'd3) qo_ok <= unit_ok;
@@ -753,7 +780,8 @@ module ts_core_commit #(
               else if (cur_vlim && vmax_bad) finish(1'b0, E_LIMITS, ev_j8);
               else if (cur_mu[MU_W-1]) finish(1'b0, E_PARAM, ev_j8);
               else begin
-                sh_kt[ev_j*KT_W +: KT_W] <= cur_pris ? {KT_W{1'b0}} : kt_val;
+                for (ki = 0; ki < NMAX; ki = ki + 1)
+                  if ({{(32 - JI_W){1'b0}}, ev_j} == ki) sh_kt[ki*KT_W +: KT_W] <= cur_pris ? {KT_W{1'b0}} : kt_val;
                 reach <= reach_next;
                 if (s_abs > smax_abs) begin
                   smax_abs <= s_abs;

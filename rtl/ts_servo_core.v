@@ -244,17 +244,38 @@ module ts_servo_core #(
   reg sv_cv;
 
   // sign extension of the shadow words to 32 / CD_W bits
-  wire [QUAT_W-1:0] j_oqw = c_oqw[lj*QUAT_W +: QUAT_W], j_oqx = c_oqx[lj*QUAT_W +: QUAT_W];
-  wire [QUAT_W-1:0] j_oqy = c_oqy[lj*QUAT_W +: QUAT_W], j_oqz = c_oqz[lj*QUAT_W +: QUAT_W];
-  wire [QUAT_W-1:0] j_ax = c_ax[lj*QUAT_W +: QUAT_W], j_ay = c_ay[lj*QUAT_W +: QUAT_W];
-  wire [QUAT_W-1:0] j_az = c_az[lj*QUAT_W +: QUAT_W];
-  wire [LEN_W-1:0] j_opx = c_opx[lj*LEN_W +: LEN_W], j_opy = c_opy[lj*LEN_W +: LEN_W];
-  wire [LEN_W-1:0] j_opz = c_opz[lj*LEN_W +: LEN_W];
-  wire [SCALE_W-1:0] j_sc = c_scale[lj*SCALE_W +: SCALE_W];
-  wire [KT_W-1:0] j_kt = c_kturn[lj*KT_W +: KT_W];
-  wire [ANGLE_W-1:0] j_lo = c_lower[lj*ANGLE_W +: ANGLE_W], j_hi = c_upper[lj*ANGLE_W +: ANGLE_W];
-  wire [QD_W-1:0] j_vm = c_vmax[lj*QD_W +: QD_W];
-  wire [MU_W-1:0] j_mu = c_mu[lj*MU_W +: MU_W];
+  wire [QUAT_W-1:0] j_oqw;
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_j_oqw (.in_vec(c_oqw), .in_idx(lj), .out_el(j_oqw));
+  wire [QUAT_W-1:0] j_oqx;
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_j_oqx (.in_vec(c_oqx), .in_idx(lj), .out_el(j_oqx));
+  wire [QUAT_W-1:0] j_oqy;
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_j_oqy (.in_vec(c_oqy), .in_idx(lj), .out_el(j_oqy));
+  wire [QUAT_W-1:0] j_oqz;
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_j_oqz (.in_vec(c_oqz), .in_idx(lj), .out_el(j_oqz));
+  wire [QUAT_W-1:0] j_ax;
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_j_ax (.in_vec(c_ax), .in_idx(lj), .out_el(j_ax));
+  wire [QUAT_W-1:0] j_ay;
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_j_ay (.in_vec(c_ay), .in_idx(lj), .out_el(j_ay));
+  wire [QUAT_W-1:0] j_az;
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_j_az (.in_vec(c_az), .in_idx(lj), .out_el(j_az));
+  wire [LEN_W-1:0] j_opx;
+  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_j_opx (.in_vec(c_opx), .in_idx(lj), .out_el(j_opx));
+  wire [LEN_W-1:0] j_opy;
+  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_j_opy (.in_vec(c_opy), .in_idx(lj), .out_el(j_opy));
+  wire [LEN_W-1:0] j_opz;
+  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_j_opz (.in_vec(c_opz), .in_idx(lj), .out_el(j_opz));
+  wire [SCALE_W-1:0] j_sc;
+  ts_sel #(.W(SCALE_W), .N(NMAX), .IW(JI_W)) u_sel_j_sc (.in_vec(c_scale), .in_idx(lj), .out_el(j_sc));
+  wire [KT_W-1:0] j_kt;
+  ts_sel #(.W(KT_W), .N(NMAX), .IW(JI_W)) u_sel_j_kt (.in_vec(c_kturn), .in_idx(lj), .out_el(j_kt));
+  wire [ANGLE_W-1:0] j_lo;
+  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_j_lo (.in_vec(c_lower), .in_idx(lj), .out_el(j_lo));
+  wire [ANGLE_W-1:0] j_hi;
+  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_j_hi (.in_vec(c_upper), .in_idx(lj), .out_el(j_hi));
+  wire [QD_W-1:0] j_vm;
+  ts_sel #(.W(QD_W), .N(NMAX), .IW(JI_W)) u_sel_j_vm (.in_vec(c_vmax), .in_idx(lj), .out_el(j_vm));
+  wire [MU_W-1:0] j_mu;
+  ts_sel #(.W(MU_W), .N(NMAX), .IW(JI_W)) u_sel_j_mu (.in_vec(c_mu), .in_idx(lj), .out_el(j_mu));
 
   always @(*) begin
     fk_cd = 32'd0;
@@ -317,8 +338,13 @@ module ts_servo_core #(
 
   // ---- per-tick input words ------------------------------------------------------------------------
   wire [JI_W-1:0] pjj = pj[JI_W-1:0];
-  wire [ANGLE_W-1:0] q_sel = use_int ? q_int[pjj*ANGLE_W +: ANGLE_W] : qbuf[pjj*ANGLE_W +: ANGLE_W];
-  wire [QD_W-1:0] warm_sel = ctl[0] ? {QD_W{1'b0}} : qd_prev[pjj*QD_W +: QD_W];
+  wire [ANGLE_W-1:0] q_int_j, qbuf_j;
+  wire [QD_W-1:0] qd_prev_j;
+  ts_sel #(.W(ANGLE_W), .N(JN), .IW(JI_W)) u_sel_qint (.in_vec(q_int), .in_idx(pjj), .out_el(q_int_j));
+  ts_sel #(.W(ANGLE_W), .N(JN), .IW(JI_W)) u_sel_qbuf (.in_vec(qbuf), .in_idx(pjj), .out_el(qbuf_j));
+  ts_sel #(.W(QD_W), .N(JN), .IW(JI_W)) u_sel_warm (.in_vec(qd_prev), .in_idx(pjj), .out_el(qd_prev_j));
+  wire [ANGLE_W-1:0] q_sel = use_int ? q_int_j : qbuf_j;
+  wire [QD_W-1:0] warm_sel = ctl[0] ? {QD_W{1'b0}} : qd_prev_j;
   wire in_prep = (st == S_PREP);
 
   // setpoint words (low bits of each 32-bit word)
@@ -392,7 +418,7 @@ module ts_servo_core #(
   reg [2:0] wc;                   // field being written (column or V)
   reg wr_act;                     // a column / V write burst is running
   reg law_ok;                     // the law's evaluation has ended
-  reg [6*32-1:0] hold;            // the six words being written, sign-extended to 32 bits
+  reg [6*CD_W-1:0] hold;          // the six words being written, sign-extended to CD_W bits
   reg sv_start;
   wire sv_busy, sv_done;
   wire [NMAX*QD_W-1:0] sv_qd;
@@ -403,7 +429,8 @@ module ts_servo_core #(
   reg [LA_W-1:0] sv_xa;
   reg [CD_W-1:0] sv_xd;
 
-  wire [CD_W-1:0] hold_w = hold[wc*32 +: CD_W];
+  wire [CD_W-1:0] hold_w;
+  ts_sel #(.W(CD_W), .N(6), .IW(3)) u_sel_hold (.in_vec(hold), .in_idx(wc), .out_el(hold_w));
   always @(*) begin
     sv_xwe = 1'b0;
     sv_xa = {LA_W{1'b0}};
@@ -432,8 +459,10 @@ module ts_servo_core #(
   wire [WI_W-1:0] ow_e = ow - n_w - n_w;           // ep/eo/status/count index
   wire [JI_W-1:0] oj_d = ow[JI_W-1:0];
   wire [JI_W-1:0] oj_n = ow[JI_W-1:0] - n_c[JI_W-1:0];   // q_next index
-  wire [QD_W-1:0] o_qd = qd_prev[oj_d*QD_W +: QD_W];
-  wire [ANGLE_W-1:0] o_qn = q_int[oj_n*ANGLE_W +: ANGLE_W];
+  wire [QD_W-1:0] o_qd;
+  wire [ANGLE_W-1:0] o_qn;
+  ts_sel #(.W(QD_W), .N(JN), .IW(JI_W)) u_sel_oqd (.in_vec(qd_prev), .in_idx(oj_d), .out_el(o_qd));
+  ts_sel #(.W(ANGLE_W), .N(JN), .IW(JI_W)) u_sel_oqn (.in_vec(q_int), .in_idx(oj_n), .out_el(o_qn));
   reg [PE_W-1:0] o_ep;
   reg [RO_W-1:0] o_eo;
   always @(*) begin
@@ -472,7 +501,7 @@ module ts_servo_core #(
       tick_count <= 32'd0; tick_cycles <= 32'd0; flags_set <= 18'd0;
       c_start <= 1'b0; fk_start <= 1'b0; law_start <= 1'b0; sv_start <= 1'b0;
       col_addr <= {JI_W{1'b0}}; col_v <= 1'b0; ci <= {(JI_W + 1){1'b0}}; tm <= 3'd0;
-      wj <= {(JI_W + 1){1'b0}}; wc <= 3'd0; wr_act <= 1'b0; law_ok <= 1'b0; hold <= {(6 * 32){1'b0}};
+      wj <= {(JI_W + 1){1'b0}}; wc <= 3'd0; wr_act <= 1'b0; law_ok <= 1'b0; hold <= {(6 * CD_W){1'b0}};
       for (k = 0; k < 13; k = k + 1) sp[k] <= 32'd0;
     end else begin
       c_start <= 1'b0; fk_start <= 1'b0; law_start <= 1'b0; sv_start <= 1'b0; col_v <= 1'b0;
@@ -544,24 +573,24 @@ module ts_servo_core #(
           if (tm == 3'd1) col_addr <= ci[JI_W-1:0];
           if (law_done) law_ok <= 1'b1;
           if (lc_valid) begin
-            hold <= {{{(33 - JV_W){lc_vz[JV_W-1]}}, lc_vz[JV_W-2:0]},
-                     {{(33 - JV_W){lc_vy[JV_W-1]}}, lc_vy[JV_W-2:0]},
-                     {{(33 - JV_W){lc_vx[JV_W-1]}}, lc_vx[JV_W-2:0]},
-                     {{(33 - JW_W){lc_wz[JW_W-1]}}, lc_wz[JW_W-2:0]},
-                     {{(33 - JW_W){lc_wy[JW_W-1]}}, lc_wy[JW_W-2:0]},
-                     {{(33 - JW_W){lc_wx[JW_W-1]}}, lc_wx[JW_W-2:0]}};
+            hold <= {{{(CD_W + 1 - JV_W){lc_vz[JV_W-1]}}, lc_vz[JV_W-2:0]},
+                     {{(CD_W + 1 - JV_W){lc_vy[JV_W-1]}}, lc_vy[JV_W-2:0]},
+                     {{(CD_W + 1 - JV_W){lc_vx[JV_W-1]}}, lc_vx[JV_W-2:0]},
+                     {{(CD_W + 1 - JW_W){lc_wz[JW_W-1]}}, lc_wz[JW_W-2:0]},
+                     {{(CD_W + 1 - JW_W){lc_wy[JW_W-1]}}, lc_wy[JW_W-2:0]},
+                     {{(CD_W + 1 - JW_W){lc_wx[JW_W-1]}}, lc_wx[JW_W-2:0]}};
             wr_act <= 1'b1; wc <= 3'd0;
           end else if (wr_act) begin
             if (wc == 3'd5) begin wr_act <= 1'b0; wj <= wj + 1'b1; end
             wc <= wc + 1'b1;
           end
           if ((law_ok || law_done) && (wj == n_c) && !wr_act) begin
-            hold <= {{{(33 - V_W){vv_z[V_W-1]}}, vv_z[V_W-2:0]},
-                     {{(33 - V_W){vv_y[V_W-1]}}, vv_y[V_W-2:0]},
-                     {{(33 - V_W){vv_x[V_W-1]}}, vv_x[V_W-2:0]},
-                     {{(33 - V_W){vw_z[V_W-1]}}, vw_z[V_W-2:0]},
-                     {{(33 - V_W){vw_y[V_W-1]}}, vw_y[V_W-2:0]},
-                     {{(33 - V_W){vw_x[V_W-1]}}, vw_x[V_W-2:0]}};
+            hold <= {{{(CD_W + 1 - V_W){vv_z[V_W-1]}}, vv_z[V_W-2:0]},
+                     {{(CD_W + 1 - V_W){vv_y[V_W-1]}}, vv_y[V_W-2:0]},
+                     {{(CD_W + 1 - V_W){vv_x[V_W-1]}}, vv_x[V_W-2:0]},
+                     {{(CD_W + 1 - V_W){vw_z[V_W-1]}}, vw_z[V_W-2:0]},
+                     {{(CD_W + 1 - V_W){vw_y[V_W-1]}}, vw_y[V_W-2:0]},
+                     {{(CD_W + 1 - V_W){vw_x[V_W-1]}}, vw_x[V_W-2:0]}};
             wr_act <= 1'b1; wc <= 3'd0; st <= S_V;
           end
         end

@@ -238,7 +238,8 @@ def main(argv: list[str] | None = None) -> int:
             write_doc(res, cycles, ROOT / a.out)
         print(section(res, cycles))
         return 0
-    res = {}
+    # configurations not run now keep their last results
+    res = json.loads((ROOT / a.json).read_text()) if (ROOT / a.json).exists() else {}
     for cfg in a.configs:
         res[cfg] = run(cfg, a.seeds, not a.no_pnr)
         print(cfg, json.dumps({k: v for k, v in res[cfg].items() if k != "modules"}), flush=True)

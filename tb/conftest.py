@@ -6,7 +6,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 #: the longest runs of the suite (a Verilator build plus minutes of simulation each): started first,
 #: so pytest-xdist spreads them over the workers instead of leaving them for the end
-SLOW_FIRST = ("tb/ts_servo_core/", "tb/ts_core_law/", "tb/ts_core_solve/", "tb/ts_core_fk/",
+SLOW_FIRST = ("tb/ts_servo_core/", "tb/test_rtl_track.py", "tb/ts_core_law/", "tb/ts_core_solve/", "tb/ts_core_fk/",
               "tb/ts_core_commit/", "model/tests/test_hls")
 
 

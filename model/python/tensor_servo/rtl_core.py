@@ -83,7 +83,7 @@ def harness_binary(config: str, nmax: int) -> Path:
     out = BUILD / f"{config}-n{nmax}-{key}"
     exe = out / "Vharness"
     BUILD.mkdir(parents=True, exist_ok=True)
-    with open(BUILD / ".lock", "w") as lock:
+    with open(BUILD / f".lock-{config}-n{nmax}", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         if exe.exists():
             return exe
