@@ -74,6 +74,49 @@ def parse_hier_stat(path: Path) -> dict[str, dict[str, int]]:
     return out
 
 
+def engine_totals(path: Path, own: dict[str, dict[str, int]]) -> dict[str, dict[str, int]]:
+    """Cells of each direct child of the top with everything below it (the 'design hierarchy'
+    tree of `stat`: per line a module and its number of instances in its parent), summed by the
+    child's module name (ts_core_fk, ts_sel, ...)."""
+    lines = (ROOT / path).read_text().split("=== design hierarchy ===", 1)[1].splitlines()
+    rows = []
+    for ln in lines:
+        m = re.match(r"^( +)(\S+)\s+(\d+)\s*$", ln)
+        if m:
+            rows.append((len(m.group(1)), m.group(2), int(m.group(3))))
+        elif rows and ln.strip() and not ln.startswith(" "):
+            break
+
+    def subtree(i: int) -> tuple[dict[str, int], int]:
+        depth, name, _ = rows[i]
+        tot = dict(counts(own.get(name, {})))
+        j = i + 1
+        while j < len(rows) and rows[j][0] > depth:
+            sub, nxt = subtree(j)
+            for k in tot:
+                tot[k] += rows[j][2] * sub[k]
+            j = nxt
+        return tot, j
+
+    out: dict[str, dict[str, int]] = {}
+    if not rows:
+        return out
+    j = 1
+    while j < len(rows) and rows[j][0] > rows[0][0]:
+        sub, nxt = subtree(j)
+        name = rows[j][1].split("\\")[-1]
+        if re.fullmatch(r"[A-Z0-9_]+", name):     # a cell type listed under the top, not a module
+            j = nxt
+            continue
+        acc = out.setdefault(name, {k: 0 for k in sub})
+        for k in sub:
+            acc[k] += rows[j][2] * sub[k]
+        j = nxt
+    top_own = counts(own.get(rows[0][1], {}))
+    out["(top's own logic)"] = top_own
+    return out
+
+
 def engine_of(module_name: str) -> str | None:
     """The engine a (parametrised, e.g. '$paramod$...\\ts_core_fk') module name belongs to."""
     for e in ["ts_servo_core"] + ENGINES:
@@ -100,10 +143,8 @@ def run(cfg: str, seeds: list[int], pnr: bool) -> dict:
     hs = parse_hier_stat(stat)
     # Per engine: the 'design hierarchy' section only totals; each module's own section counts its
     # own cells, submodules (quaternion units, ROMs, ...) are added to their engine via the hierarchy.
-    r = {"t_syn": time.time() - t0, "total": counts(hs.get("total", {})), "modules": {}}
-    for name, c in hs.items():
-        if name != "total":
-            r["modules"][name] = counts(c)
+    r = {"t_syn": time.time() - t0, "total": counts(hs.get("total", {})),
+         "engines": engine_totals(stat, {k: v for k, v in hs.items() if k != "total"})}
     r["fits"] = []
     tot = r["total"]
     for opt, dev, mult, lut, ebr in DEVICES:
@@ -158,12 +199,12 @@ def section(res: dict, cycles: dict) -> str:
     cfgs = [c for c in ("default", "compact") if c in res]
     for cfg in cfgs:
         r = res[cfg]
-        for name, c in sorted(r["modules"].items(), key=lambda kv: -kv[1]["MULT18X18D"]):
-            if c["MULT18X18D"] or c["LUT4"] > 200:
-                out.append(f"| {cfg} | `{name.split(chr(92))[-1] if chr(92) in name else name}` (own cells) | {fmt_counts(c)} |")
+        for name, c in sorted(r["engines"].items(), key=lambda kv: (-kv[1]["MULT18X18D"], -kv[1]["LUT4"])):
+            out.append(f"| {cfg} | `{name}` | {fmt_counts(c)} |" if not name.startswith("(") else
+                       f"| {cfg} | {name} | {fmt_counts(c)} |")
         out.append(f"| {cfg} | **whole core** | {fmt_counts(r['total'])} |")
-    out += ["", "(Per block: the cells of that module itself; its submodules -- quaternion units, multipliers, "
-            "rounding -- are their own rows; the whole-core row is yosys's hierarchy total.)", "",
+    out += ["", "(Each engine with everything it instantiates; `ts_sel` rows are the top's multiplexers; the "
+            "whole-core row is yosys's hierarchy total.)", "",
             "| config | fits LFE5U-25F / 45F / 85F (MULT18X18D 28 / 72 / 156) | placed on | post-route Fmax (MHz) "
             "| cycles/tick 6 joints, 2 / 10 sweeps | 7 joints, 2 / 10 sweeps |", "|---|---|---|---|---|---|"]
     lines = []
@@ -233,6 +274,12 @@ def main(argv: list[str] | None = None) -> int:
     a = ap.parse_args(argv)
     if a.doc_only:
         res = json.loads((ROOT / a.json).read_text())
+        for cfg in ("default", "compact"):       # the per-engine sums from the stat files of the run
+            stat = WORK / f"ts_servo_core_{cfg}" / "ecp5_stat.txt"
+            if cfg in res and (ROOT / stat).exists():
+                hs = parse_hier_stat(stat)
+                res[cfg]["engines"] = engine_totals(stat, {k: v for k, v in hs.items() if k != "total"})
+                res[cfg].pop("modules", None)
         cycles = measure_cycles([c for c in ("default", "compact") if c in res])
         if a.out:
             write_doc(res, cycles, ROOT / a.out)

@@ -95,7 +95,7 @@ def test_rtl_core_tracks_bit_identical_to_the_model(name, cfg):
             pytest.fail(f"{name} {cfg} (seed {SEED}): {k} differs first at {tuple(bad)}: fixed {a[tuple(bad)]} rtl {b[tuple(bad)]}")
     cyc = tick.core.cycles
     assert len(cyc) == NT and min(cyc) > 0
-    print(f"[rtl track] {name} {cfg} n={ch.n} NMAX={tick.core.nmax}: {NT} ticks identical to the model; "
+    print(f"[rtl track] {name} {cfg} n={ch.n} NMAX={tick.core.nmax} (seed {SEED}): {NT} ticks identical to the model; "
           f"{SWEEPS} sweeps: {min(cyc)}-{max(cyc)} cycles per tick; flags {int(np.bitwise_or.reduce(rt.flags)):#x}")
 
 

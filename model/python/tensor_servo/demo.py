@@ -32,8 +32,8 @@ from .rtl_core import ROOT
 from .track import make_tick, relative_poses, track
 
 DEFAULT_PNG = ROOT / "build" / "demo" / "tracking_error.png"
-#: the clock the implied tick rate is quoted at: the slowest RTL primitive's post-route Fmax goal
-#: on LFE5U-85F -6 (docs/resources.md); the whole core's Fmax is reported there when measured
+#: the clock the implied tick rate is quoted at (an assumption, printed as such): the primitives'
+#: post-route Fmax goal on LFE5U-85F -6; the whole core's measured Fmax is in docs/resources.md
 CLOCK_MHZ = 150.0
 
 
@@ -122,6 +122,8 @@ def demo(a) -> int:
     ns = c / a.clock_mhz * 1e3
     print(f"  cycles per tick (TICK_CYCLES, 10 sweeps): {c} (min {cyc.min()}, max {cyc.max()}); at {a.clock_mhz:g} MHz "
           f"{ns / 1e3:.1f} us per tick, {1e9 / ns:,.0f} ticks/s")
+    print(f"    ({a.clock_mhz:g} MHz is an assumed clock (--clock-mhz); the post-route Fmax of the whole core is in "
+          "docs/resources.md)")
     print(f"  simulation: {K} ticks in {secs:.1f} s ({K * c / secs / 1e3:.0f} kcycles/s in Verilator)")
     out = Path(a.output)
     plot(out, np.arange(K) * dt, {"float": (fl, "k-"), f"fixed {cfg}": (fx, "b--"), "rtl core": (rt, "r:")},
