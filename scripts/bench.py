@@ -146,8 +146,13 @@ def core_fmax() -> dict:
     res = json.loads(f.read_text()) if f.exists() else {}
     out = {}
     for cfg in ("default", "compact"):
-        r = res.get(cfg)
-        out[cfg] = (min(r["fmax"]), r["device"]) if r and r.get("fmax") else None
+        r = res.get(cfg) or {}
+        if r.get("fmax"):
+            out[cfg] = (min(r["fmax"]), r["device"])
+        elif r.get("fmax_placed"):     # routing did not finish: nextpnr's post-placement estimate
+            out[cfg] = (r["fmax_placed"], r["device"] + ", post-placement estimate")
+        else:
+            out[cfg] = None
     return out
 
 

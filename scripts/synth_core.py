@@ -183,6 +183,30 @@ def measure_cycles(configs: list[str]) -> dict:
             for cfg in configs}
 
 
+def pnr_logs(d: Path) -> dict:
+    """What the nextpnr logs of a run say: the post-placement Fmax estimate, the post-route Fmax
+    (if routing finished) and the critical path's first and last cells, per device."""
+    out: dict = {}
+    for log in sorted((ROOT / d).glob("pnr_*_seed*.log")):
+        text = log.read_text()
+        dev = log.name.split("_")[1]
+        f = [float(x) for x in re.findall(r"Max frequency for clock\s+'clk':\s+([\d.]+) MHz", text)]
+        routed = "Routing complete" in text or "Program finished normally" in text
+        m = re.search(r"TRELLIS_COMB:\s+(\d+)/", text)
+        out["device"] = dev
+        out["comb"] = int(m.group(1)) if m else None
+        out["fmax_placed"] = f[0] if f else None
+        out["fmax"] = [f[-1]] if routed and len(f) > 1 else []
+        out["routed"] = routed
+        arcs = re.findall(r"Routing (\d+) arcs", text)
+        left = re.findall(r"^Info:\s+\d+ \|\s+\d+\s+\d+ \|\s+\d+\s+\d+ \|\s+(\d+)\|", text, re.M)
+        out["route_progress"] = (int(arcs[0]), int(left[-1])) if arcs and left else None
+        crit = re.findall(r"Info:\s+[\d.]+\s+[\d.]+\s+Source (\S+)", text)
+        sink = re.findall(r"Info:\s+[\d.]+\s+[\d.]+\s+Sink (\S+)", text)
+        out["critical"] = (crit[0], sink[-1]) if crit and sink else None
+    return out
+
+
 def fmt_counts(c: dict) -> str:
     return f"{c['LUT4']} | {c['CCU2C']} | {c['FF']} | {c['MULT18X18D']} | {c['EBR']}"
 
@@ -212,7 +236,14 @@ def section(res: dict, cycles: dict) -> str:
         r = res[cfg]
         fits = " / ".join("yes" if ok else "no" for _, ok in r["fits"])
         f = r["fmax"]
-        fs = f"{min(f):.1f} worst of {len(f)} seed(s)" if f else (r.get("pnr_error") or "not placed (does not fit)")
+        if f:
+            fs = f"{min(f):.1f} worst of {len(f)} seed(s)"
+        elif r.get("fmax_placed"):
+            rp = r.get("route_progress")
+            fs = (f"routing not finished ({rp[1]:,} of {rp[0]:,} arcs left when stopped); post-placement estimate "
+                  f"{r['fmax_placed']:.1f}" if rp else f"post-placement estimate {r['fmax_placed']:.1f}")
+        else:
+            fs = r.get("pnr_error") or "not placed (does not fit)"
         cy = cycles.get(cfg, {})
         c6 = " / ".join(str(cy.get(6, {}).get(sw, "-")) for sw in SWEEPS)
         c7 = " / ".join(str(cy.get(7, {}).get(sw, "-")) for sw in SWEEPS)
@@ -225,6 +256,10 @@ def section(res: dict, cycles: dict) -> str:
                 ns = c / min(f) * 1e3
                 lines.append(f"{n}-joint tick: {ns:.0f} ns per tick ({c} cycles at {min(f):.1f} MHz, {r['device']} -6), "
                              f"{cfg} configuration, 2 sweeps")
+            elif r.get("fmax_placed"):
+                fp = r["fmax_placed"]
+                lines.append(f"{n}-joint tick: {c / fp * 1e3:.0f} ns per tick ({c} cycles at {fp:.1f} MHz, {r['device']} -6, "
+                             f"post-placement estimate: routing did not finish), {cfg} configuration, 2 sweeps")
             else:
                 lines.append(f"{n}-joint tick: not measured post-route in the {cfg} configuration ({c} cycles at 2 "
                              f"sweeps; the core does not fit LFE5U-85F: {r['total']['MULT18X18D']} MULT18X18D of 156)")
@@ -280,6 +315,9 @@ def main(argv: list[str] | None = None) -> int:
                 hs = parse_hier_stat(stat)
                 res[cfg]["engines"] = engine_totals(stat, {k: v for k, v in hs.items() if k != "total"})
                 res[cfg].pop("modules", None)
+            if cfg in res:
+                res[cfg].update(pnr_logs(WORK / f"ts_servo_core_{cfg}"))
+        (ROOT / a.json).write_text(json.dumps(res, indent=1))
         cycles = measure_cycles([c for c in ("default", "compact") if c in res])
         if a.out:
             write_doc(res, cycles, ROOT / a.out)
