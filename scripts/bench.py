@@ -148,9 +148,9 @@ def core_fmax() -> dict:
     for cfg in ("default", "compact"):
         r = res.get(cfg) or {}
         if r.get("fmax"):
-            out[cfg] = (min(r["fmax"]), r["device"])
+            out[cfg] = (min(r["fmax"]), r["device"] + " -6")
         elif r.get("fmax_placed"):     # routing did not finish: nextpnr's post-placement estimate
-            out[cfg] = (r["fmax_placed"], r["device"] + ", post-placement estimate")
+            out[cfg] = (r["fmax_placed"], r["device"] + " -6, post-placement estimate")
         else:
             out[cfg] = None
     return out
@@ -163,7 +163,8 @@ def bench_core(seconds: float) -> str:
     fmax = core_fmax()
     lines = [f"Tick: FK, Jacobian, servo law (A, feed-forward), {CORE_SWEEPS} descent sweeps. Core: cycles per tick "
              "(TICK_CYCLES) of the Verilated core measured in this run, at the worst-seed post-route Fmax of the "
-             "whole core from `scripts/synth_core.py` (build/synth/core_results.json; not re-run by make bench). "
+             "whole core from `scripts/synth_core.py` (build/synth/core_results.json; not re-run by make bench), or "
+             "nextpnr's post-placement estimate where routing did not finish. "
              "Peer: `model/bench/bench_tick.cpp`, the model's `servo_tick` in double, -O3 -march=native, one core, "
              "min / median ns over 7 repetitions.", "",
              "| config | chain | joints | core cycles/tick | core Fmax | core ns/tick | C++ double ns/tick (min / median) "
@@ -187,7 +188,7 @@ def bench_core(seconds: float) -> str:
                                    f"(see docs/resources.md); {c} cycles would need {c / CORE_GOAL_NS * 1e3:.0f} MHz.")
                 continue
             ns = c / fm[0] * 1e3
-            lines.append(f"| {cfg} | {name} | {n} | {c} | {fm[0]:.1f} MHz ({fm[1]} -6) | {ns:.0f} | {d_min:.0f} / "
+            lines.append(f"| {cfg} | {name} | {n} | {c} | {fm[0]:.1f} MHz ({fm[1]}) | {ns:.0f} | {d_min:.0f} / "
                          f"{d_med:.0f} | {ns / d_min:.2f} |")
             if n == 6:
                 verdict.append(f"- Goal: 6-joint tick <= {CORE_GOAL_NS:.0f} ns ({cfg}, {fm[1]}): {ns:.0f} ns -> "

@@ -117,6 +117,15 @@ def engine_totals(path: Path, own: dict[str, dict[str, int]]) -> dict[str, dict[
     return out
 
 
+def stat_results(stat: Path) -> dict:
+    """Whole-core counts, per-engine sums and which devices they fit, from a `stat` file."""
+    hs = parse_hier_stat(stat)
+    tot = counts(hs.get("total", {}))
+    fits = [(dev, tot["MULT18X18D"] <= mult and tot["LUT4"] + 2 * tot["CCU2C"] <= lut and tot["EBR"] <= ebr)
+            for _, dev, mult, lut, ebr in DEVICES]
+    return {"total": tot, "engines": engine_totals(stat, {k: v for k, v in hs.items() if k != "total"}), "fits": fits}
+
+
 def engine_of(module_name: str) -> str | None:
     """The engine a (parametrised, e.g. '$paramod$...\\ts_core_fk') module name belongs to."""
     for e in ["ts_servo_core"] + ENGINES:
@@ -140,16 +149,7 @@ def run(cfg: str, seeds: list[int], pnr: bool) -> dict:
     p = sh([exe, "-q", "-l", str(d / "ecp5_yosys.log"), "-s", str(ys)], timeout=4 * 3600)
     if p.returncode != 0:
         raise RuntimeError(f"ts_servo_core/{cfg}: synth_ecp5 failed, see {d}/ecp5_yosys.log")
-    hs = parse_hier_stat(stat)
-    # Per engine: the 'design hierarchy' section only totals; each module's own section counts its
-    # own cells, submodules (quaternion units, ROMs, ...) are added to their engine via the hierarchy.
-    r = {"t_syn": time.time() - t0, "total": counts(hs.get("total", {})),
-         "engines": engine_totals(stat, {k: v for k, v in hs.items() if k != "total"})}
-    r["fits"] = []
-    tot = r["total"]
-    for opt, dev, mult, lut, ebr in DEVICES:
-        ok = tot["MULT18X18D"] <= mult and tot["LUT4"] + 2 * tot["CCU2C"] <= lut and tot["EBR"] <= ebr
-        r["fits"].append((dev, ok))
+    r = {"t_syn": time.time() - t0, **stat_results(stat)}
     r["fmax"], r["device"], r["comb"] = [], None, None
     fit = [(opt, dev) for (opt, dev, *_), (_, ok) in zip(DEVICES, r["fits"]) if ok]
     if pnr and fit:
@@ -312,8 +312,7 @@ def main(argv: list[str] | None = None) -> int:
         for cfg in ("default", "compact"):       # the per-engine sums from the stat files of the run
             stat = WORK / f"ts_servo_core_{cfg}" / "ecp5_stat.txt"
             if cfg in res and (ROOT / stat).exists():
-                hs = parse_hier_stat(stat)
-                res[cfg]["engines"] = engine_totals(stat, {k: v for k, v in hs.items() if k != "total"})
+                res[cfg].update(stat_results(stat))
                 res[cfg].pop("modules", None)
             if cfg in res:
                 res[cfg].update(pnr_logs(WORK / f"ts_servo_core_{cfg}"))
