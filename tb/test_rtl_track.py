@@ -164,3 +164,19 @@ def test_rtl_core_refuses_a_warm_start_it_does_not_keep():
     finally:
         tick.core.close()
 
+
+
+def test_rtl_core_refusal_names_the_code_and_the_field():
+    """A configuration the core refuses (an axis made non-unit after quantisation) raises one
+    InputError with CFG_ERROR's code and joint and the model's field for the same words."""
+    from tensor_servo.rtl_core import RtlServo
+
+    core = RtlServo(robots.load("puma560"), "compact", dt=DT, sweeps=2)
+    try:
+        core.raw["joints"][2]["axis"][0] += 1 << 12
+        with pytest.raises(InputError) as e:
+            core.commit()
+        msg = str(e.value)
+        assert "CFG_ERROR 2 at joint 2" in msg and "joints[2]" in msg and "\n" not in msg, msg
+    finally:
+        core.close()

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from . import regs
+from . import _model, regs
 from .chain import Chain
 from .errors import InputError
 from .model import formats
@@ -43,8 +43,6 @@ CONFIG_INDEX = {"default": 0, "compact": 1}
 NMAX_DEFAULT = 8
 LEAK_MAX = regs.MODE_WARM_LEAK_MASK >> regs.MODE_WARM_LEAK_SHIFT     # 4-bit field
 SWEEPS_MAX = regs.MODE_SWEEPS_MASK >> regs.MODE_SWEEPS_SHIFT         # 8-bit field
-CFG_ERROR_NAMES = {1: "joint count", 2: "quaternion not unit", 3: "axis not unit", 4: "scale",
-                   5: "limits", 6: "reach", 10: "servo parameter"}
 IN_COLD, IN_LOAD_Q = 1, 2
 
 
@@ -233,8 +231,10 @@ class RtlServo:
             e = self.sim.read(regs.CFG_ERROR)
             code, joint = e & 0xFF, (e >> 8) & 0xFF
             where = "" if joint == 0xFF else f" at joint {joint}"
-            raise InputError("chain", f"the core refused the configuration: CFG_ERROR {code} "
-                                      f"({CFG_ERROR_NAMES.get(code, 'unknown')}){where}")
+            # the model's commit step on the same words names the field (the same checks, in order)
+            res, _ = _model.commit_raw(self.config, self.raw, self.nmax)
+            why = f"{res['field']}: {res['message']}" if res["code"] else "the model accepts these words"
+            raise InputError("chain", f"the core refused the configuration: CFG_ERROR {code}{where} ({why})")
         self.sim.write(regs.CTRL, regs.CTRL_RUN | regs.CTRL_CLEAR)
         self.prev_qd = np.zeros(self.n, dtype=np.int64)
 
