@@ -12,7 +12,7 @@ import pytest
 from tensor_servo import reference as ref
 from tensor_servo.chain import Chain, Joint, Limits, Pose
 from tensor_servo.oracle import PinChain
-from tensor_servo.randchain import random_chain
+from tensor_servo.randchain import random_chain, random_unit
 
 TOL_PIN = 1e-12     # absolute, against Pinocchio (lengths ~ 1 m)
 TOL_FD = 1e-7       # absolute, against central finite differences
@@ -142,7 +142,7 @@ def test_rotvec_inverts_rotation():
     rng = np.random.default_rng(2)
     angles = [0.0, 1e-9, 1e-5, 9.9e-5, 1.01e-4, 1e-3, 0.3, 1.0, 2.0, 3.0, math.pi - 1e-2, math.pi - 1e-5, math.pi - 1e-9]
     for th in angles + list(rng.uniform(0, math.pi, 30)):
-        a = _unit(rng, 3)
+        a = random_unit(rng, 3)
         # rotation matrix from an independent construction (quaternion), not from ref.rotation
         R = Pose(np.zeros(3), np.r_[math.cos(th / 2), math.sin(th / 2) * a]).matrix()[:3, :3]
         assert np.allclose(ref.rotation(a, th), R, atol=1e-15, rtol=0)

@@ -11,13 +11,14 @@ import numpy as np
 from .chain import Chain, Joint, Limits, Pose
 
 
-def _unit(rng, n):
+def random_unit(rng, n):
+    """A random unit vector of n components."""
     v = rng.normal(size=n)
     return v / np.linalg.norm(v)
 
 
 def _rand_pose(rng, lo=0.05, hi=0.5):
-    return Pose(_unit(rng, 3) * rng.uniform(lo, hi), _unit(rng, 4))
+    return Pose(random_unit(rng, 3) * rng.uniform(lo, hi), random_unit(rng, 4))
 
 
 def random_chain(rng, n: int, velocity: float | None = None, scales: tuple[float, float] | None = None,
@@ -37,6 +38,6 @@ def random_chain(rng, n: int, velocity: float | None = None, scales: tuple[float
         reach = 0.5 if prismatic else math.pi          # range of scale*q
         v = None if velocity is None else velocity / abs(scale)
         lim = Limits(-reach / abs(scale), reach / abs(scale), v)
-        joints.append(Joint(f"j{i}", "prismatic" if prismatic else "revolute", _rand_pose(rng, *offset), _unit(rng, 3),
+        joints.append(Joint(f"j{i}", "prismatic" if prismatic else "revolute", _rand_pose(rng, *offset), random_unit(rng, 3),
                             lim, scale))
     return Chain(f"rand{n}", joints, _rand_pose(rng, 2 * offset[0], 2 * offset[1]), _rand_pose(rng, *offset))
