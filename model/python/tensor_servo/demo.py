@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -29,23 +28,12 @@ from .model import formats
 from .pathgen import circle
 from .plant import Plant
 from .rtl_core import ROOT
-from .track import make_tick, relative_poses, track
+from .track import relative_poses, run_model
 
 DEFAULT_PNG = ROOT / "build" / "demo" / "tracking_error.png"
 #: the clock the implied tick rate is quoted at (an assumption, printed as such): the primitives'
 #: post-route Fmax goal on LFE5U-85F -6; the whole core's measured Fmax is in docs/resources.md
 CLOCK_MHZ = 150.0
-
-
-def run(model: str, ch, cfg: str, q0, T, V, dt):
-    tick = make_tick(model, ch, config=cfg, dt=dt)
-    t0 = time.perf_counter()
-    try:
-        res = track(ch, T, V, q0, tick, Plant(q0, dt))
-    finally:
-        if tick.core is not None:
-            tick.core.close()
-    return res, tick, time.perf_counter() - t0
 
 
 def plot(path: Path, t, runs: dict, title: str) -> None:
@@ -100,9 +88,9 @@ def demo(a) -> int:
     print(f"Task-space circle (radius 5 cm, 2 s) with the orientation rocking by 0.2 rad, {K} ticks at 1 kHz;")
     print("the servo's safe defaults (error choice A, feed-forward, 10 sweeps), ideal plant.\n")
     print("The servo core in Verilator (building it the first time takes about a minute) ...", flush=True)
-    rt, tick, secs = run("rtl", ch, cfg, q0, T, V, dt)
-    fx, _, _ = run("fixed", ch, cfg, q0, T, V, dt)
-    fl, _, _ = run("float", ch, cfg, q0, T, V, dt)
+    rt, tick, secs = run_model("rtl", ch, T, V, q0, Plant(q0, dt), config=cfg, dt=dt)
+    fx, _, _ = run_model("fixed", ch, T, V, q0, Plant(q0, dt), config=cfg, dt=dt)
+    fl, _, _ = run_model("float", ch, T, V, q0, Plant(q0, dt), config=cfg, dt=dt)
     same = all(np.array_equal(getattr(rt, k), getattr(fx, k)) for k in ("q", "qd", "flags"))
     half = K // 2
     print(f"  {'run':34s} {'steady pos. error':>18s} {'steady rot. error':>18s}  flags")

@@ -43,7 +43,7 @@ CONFIG_INDEX = {"default": 0, "compact": 1}
 NMAX_DEFAULT = 8
 LEAK_MAX = regs.MODE_WARM_LEAK_MASK >> regs.MODE_WARM_LEAK_SHIFT     # 4-bit field
 SWEEPS_MAX = regs.MODE_SWEEPS_MASK >> regs.MODE_SWEEPS_SHIFT         # 8-bit field
-IN_COLD, IN_LOAD_Q = 1, 2
+IN_COLD = 1                     # input packet control word: bit 0 COLD (bit 1 LOAD_Q: virtual mode, unused here)
 
 
 def core_nmax(n: int) -> int:

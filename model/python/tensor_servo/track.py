@@ -21,6 +21,7 @@ themselves with :func:`register_model` and must return a callable with the same 
 from __future__ import annotations
 
 import math
+import time
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -335,3 +336,18 @@ def track(chain: Chain, T: np.ndarray, V: np.ndarray, q0: np.ndarray, tick: Call
         q[k + 1] = plant.step(u)
     pe, re = pose_errors(chain, q[:K], T, setpoint_frame)
     return TrackResult(q, qd, pe, re, flags, qm)
+
+
+def run_model(model: str, chain: Chain, T: np.ndarray, V: np.ndarray, q0: np.ndarray, plant: Plant, *,
+              config: str = "default", dt: float, warm="auto", **params) -> tuple[TrackResult, TickModel, float]:
+    """:func:`make_tick` then :func:`track` (setpoint frame from ``params``), releasing the back
+    end afterwards (the rtl model's simulation process).  Returns the result, the tick model
+    (``.core.cycles`` for rtl) and the seconds the loop took (construction not included)."""
+    tick = make_tick(model, chain, config=config, dt=dt, **params)
+    try:
+        t0 = time.perf_counter()
+        res = track(chain, T, V, q0, tick, plant, setpoint_frame=params.get("setpoint_frame", -1), warm=warm)
+        return res, tick, time.perf_counter() - t0
+    finally:
+        if tick.core is not None:
+            tick.core.close()
