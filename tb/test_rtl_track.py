@@ -175,3 +175,13 @@ def test_rtl_core_refusal_names_the_code_and_the_field():
         assert "CFG_ERROR 2 at joint 2" in msg and "joints[2]" in msg and "\n" not in msg, msg
     finally:
         core.close()
+
+
+def test_rtl_core_refuses_the_offline_refinement():
+    """The conjugate-direction refinement (cg) is an offline IK option of the model; the core has
+    none, so asking the rtl back end for it is refused with one line naming the field."""
+    from tensor_servo.rtl_core import RtlServo
+
+    with pytest.raises(InputError, match="^cg: .*no conjugate-direction refinement") as e:
+        RtlServo(robots.load("puma560"), "compact", dt=DT, sweeps=2, cg=4)
+    assert "\n" not in str(e.value)

@@ -206,7 +206,7 @@ py::dict formats_of() {
   TS_FMT(trig_acc_t) TS_FMT(quat_t) TS_FMT(uvec_tmp_t) TS_FMT(len_t) TS_FMT(len_tmp_t) TS_FMT(pos_t)
   TS_FMT(lever_t) TS_FMT(jw_t) TS_FMT(jv_t) TS_FMT(jw_tmp_t) TS_FMT(jv_tmp_t) TS_FMT(twopi_t) TS_FMT(sixth_t)
   TS_FMT(lchar_t) TS_FMT(tw_t) TS_FMT(jsc_t) TS_FMT(qd_t) TS_FMT(gk_t) TS_FMT(mant_t) TS_FMT(recip_t) TS_FMT(mu_t)
-  TS_FMT(step_t) TS_FMT(klim_t) TS_FMT(gain_t) TS_FMT(dt_t) TS_FMT(vel_t) TS_FMT(perr_t) TS_FMT(rot_t) TS_FMT(rvf_t)
+  TS_FMT(step_t) TS_FMT(bfm_t) TS_FMT(cgy_t) TS_FMT(cge_t) TS_FMT(cgx_t) TS_FMT(cgr_t) TS_FMT(klim_t) TS_FMT(gain_t) TS_FMT(dt_t) TS_FMT(vel_t) TS_FMT(perr_t) TS_FMT(rot_t) TS_FMT(rvf_t)
   TS_FMT(tacc_t) TS_FMT(qdiff_t) TS_FMT(inv4pi_t) TS_FMT(weight_t)
 #undef TS_FMT
   d["TRIG_TABLE_BITS"] = Fmt::TRIG_TABLE_BITS;

@@ -9,7 +9,8 @@
 // apply the chain's velocity limits),
 // mode ("A" | "B"), feedforward (bool), controlled (list of frame indices, one per task; -1 = tip t),
 // weights (list, one per task),
-// setpoint_frame (-1 = root, k = frame k of the chain).
+// setpoint_frame (-1 = root, k = frame k of the chain), cg (int, optional: conjugate-direction steps
+// after the sweeps, offline IK only; 0 = none, as the core).
 #include "common.hpp"
 #include "tensor_servo/core_config.hpp"
 
@@ -64,6 +65,8 @@ struct Servo final : ServoBase {
     S.klim = param<typename Fmt::klim_t>(pd, "klim", st);
     S.sweeps = pd["sweeps"].cast<int>();
     if (S.sweeps < 1 || S.sweeps > 1000) throw std::invalid_argument("sweeps: must be 1..1000");
+    S.cg = pd.contains("cg") ? pd["cg"].cast<int>() : 0;
+    if (S.cg < 0 || S.cg > CG_MAX) throw std::invalid_argument("cg: must be 0.." + std::to_string(CG_MAX));
     const auto mu = pd["mu"].cast<std::vector<double>>();
     if (static_cast<int>(mu.size()) != ch.n) throw std::invalid_argument("mu: one value per joint");
     const bool vlimits = pd["vlimits"].cast<bool>();

@@ -58,6 +58,11 @@ struct FmtDouble {
   using mant_t = double;
   using recip_t = double;
   using mu_t = double;
+  using bfm_t = double;
+  using cgy_t = double;
+  using cge_t = double;
+  using cgx_t = double;
+  using cgr_t = double;
   using step_t = double;
   using klim_t = double;
   using qdiff_t = double;
@@ -114,6 +119,11 @@ struct FmtDefaultT {
   using recip_t = N<18, 2, ST_OVF_SOLVER>;     // 1 / mant in (1/2, 1]
   using mu_t = N<18, 2, ST_OVF_CONST>;         // per-joint multiplier (relaxation), [0, 2)
   using step_t = N<18, 2, ST_OVF_SOLVER>;      // mu_i / mant_i
+  using bfm_t = N<27, 2, ST_OVF_SOLVER>;       // IK refinement: block-floating mantissa, |.| <= 1
+  using cgy_t = N<27, 3, ST_OVF_SOLVER>;       // IK refinement: refined reciprocal, [1, 2]
+  using cge_t = N<27, -10, ST_OVF_SOLVER>;     // IK refinement: Newton error 1 - m y, |.| < 2^-12
+  using cgx_t = N<60, 30, ST_OVF_SOLVER>;      // IK refinement: increment of q' / 2^k0 (|r0| < 2^k0)
+  using cgr_t = N<60, 2, ST_OVF_SOLVER>;       // IK refinement: residual / 2^k0, |.| < 2
   using klim_t = N<27, 15, ST_OVF_CONST>;      // limit-approach gain (1/s)
   using qdiff_t = N<33, 5, ST_OVF_SOLVER>;     // limit - q, exact (33-bit operand: 4 MULT18X18D)
   using gain_t = N<27, 15, ST_OVF_CONST>;      // servo gains K_p, K_o (1/s)
@@ -167,6 +177,11 @@ struct FmtCompactT {
   using recip_t = N<18, 2, ST_OVF_SOLVER>;
   using mu_t = N<18, 2, ST_OVF_CONST>;
   using step_t = N<18, 2, ST_OVF_SOLVER>;
+  using bfm_t = N<18, 2, ST_OVF_SOLVER>;
+  using cgy_t = N<18, 3, ST_OVF_SOLVER>;
+  using cge_t = N<18, -10, ST_OVF_SOLVER>;
+  using cgx_t = N<48, 24, ST_OVF_SOLVER>;
+  using cgr_t = N<48, 2, ST_OVF_SOLVER>;
   using klim_t = N<18, 15, ST_OVF_CONST>;
   using qdiff_t = N<18, 5, ST_OVF_SOLVER>;     // limit - q rounded to an 18-bit operand
   using gain_t = N<18, 15, ST_OVF_CONST>;

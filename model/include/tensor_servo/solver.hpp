@@ -44,7 +44,11 @@ struct SolverParams {
   typename Fmt::qd_t vmax[NMAX];           // velocity limit (format max when none)
   typename Fmt::klim_t klim;               // limit-approach gain (1/s)
   int sweeps = 2;
+  int cg = 0;                              // conjugate-direction steps after the sweeps (0..CG_MAX;
+                                           // offline IK only: the core has none, see solver_cg)
 };
+
+constexpr int CG_MAX = 64;
 
 // Per-column quantities computed once per tick.  ROWS = 6 x (number of stacked tasks); a serial
 // chain with one controlled frame has 6.
@@ -124,6 +128,12 @@ inline void step_factor(const D& d, typename Fmt::mu_t mu, typename Fmt::step_t&
   }
 }
 
+// The value 1 of a storage type (double or a fixed-point format with an integer bit).
+template <class T> inline T one_of() {
+  if constexpr (std::is_same_v<T, double>) return 1.0;
+  else return T::from_raw(int64_t(1) << T::F);
+}
+
 template <class T> inline T tmin(const T& a, const T& b) { return b < a ? b : a; }
 template <class T> inline T tmax(const T& a, const T& b) { return a < b ? b : a; }
 
@@ -196,6 +206,178 @@ inline void solver_prepare(const SolverParams<Fmt, NMAX>& P, const Jacobian<Fmt,
   solver_steps(P, q, J.n, C, st);
 }
 
+// Block floating point: out[i] = v[i] 2^-k rounded to bfm_t with k = 1 + the leading-one position
+// of max |v[i]|, so 1/2 <= max |out| <= 1 and rounding never saturates (bfm_t has 2 integer bits).
+// Returns false (out zero, k = 0) when every v[i] (i < m) is zero.
+template <class Fmt, int M, class V>
+inline bool block_norm(const V* v, int m, typename Fmt::bfm_t* out, int& k, Status& st) {
+  using bfm_t = typename Fmt::bfm_t;
+  int top = -(1 << 20);
+  for (int i = 0; i < M; ++i) {
+    if (i >= m) continue;
+    const int ki = v[i] < V{} ? ilog2(-v[i]) : ilog2(v[i]);
+    top = ki > top ? ki : top;
+  }
+  k = top > -(1 << 20) ? top + 1 : 0;
+  for (int i = 0; i < M; ++i) out[i] = i < m && top > -(1 << 20) ? cvt_shr<bfm_t>(v[i], k, st) : bfm_t{};
+  return top > -(1 << 20);
+}
+
+// Exact combination out[a] = sum_i js[i][a] x[i] of the scaled columns (rows a < rows, joints
+// i < n): the accumulator has 7 more integer bits than one product (n <= 64), so it never rounds.
+template <class Fmt, int NMAX, int ROWS, class X>
+inline auto columns_times(const typename Fmt::jsc_t (*js)[ROWS], const X* x, int n, int a) {
+  if constexpr (Fmt::is_float) {
+    double acc = 0;
+    for (int i = 0; i < NMAX; ++i)
+      if (i < n) acc += js[i][a] * x[i];
+    return acc;
+  } else {
+    using P = num_traits<decltype(js[0][0] * x[0])>;
+    using Acc = typename Fmt::template num<P::W + 7, P::I + 7>;
+    Acc acc = Acc::from_raw(0);
+    for (int i = 0; i < NMAX; ++i)
+      if (i < n) acc = wrap<Acc>(acc + js[i][a] * x[i]);  // |sum| < 2^(P::I + 6): never wraps
+    return acc;
+  }
+}
+
+// Conjugate-direction refinement after the sweeps (SolverParams::cg steps; the offline IK's polish,
+// docs/ik.md): conjugate gradients on the normal equations of the scaled problem (CGLS) for the
+// increment d of q', over the joints that are not frozen (mu_i = 0) and not held at a bound by the
+// gradient, from the sweeps' q' and exact residual r0.  Division-free like the sweeps:
+//   - vectors and scalars are held in block floating point: bfm_t mantissas, run-time exponents;
+//   - the increment d and the residual r of the recurrence are fixed point relative to r0's
+//     exponent k0 (cgx_t, cgr_t), so steps far below one LSB of qd_t still count;
+//   - the two ratios of a step, the line search alpha = <A p, r> / |A p|^2 along the direction p
+//     and the conjugacy coefficient beta = -<A s, A p> / |A p|^2 of the next direction
+//     p' = s + beta p (s = A^T r), share one reciprocal of |A p|^2: the solver's table and Newton
+//     step (step_factor with mu = 1, relative error < 2^-13), then one more Newton step in cgy_t
+//     (relative error ~ 2^-24).  CG on an ill-conditioned problem needs the ratios to about that
+//     precision: with the 2^-13 of the sweeps' reciprocal it stalls (measured, docs/ik.md).
+// In exact arithmetic the refinement reaches the least-squares solution of the free joints in as
+// many steps as there are free joints, whatever the condition number, where the sweeps crawl at
+// about 1 - 1/cond^2 per sweep.  A step that would take a joint out of its box is not made and
+// ends the refinement.  At the end q' += d (rounded to qd_t, clamped) and the solver's residual is
+// updated exactly for what q' really moved.  The core has no such unit: cg = 0 there.
+template <class Fmt, int NMAX, int ROWS>
+inline void solver_cg(const SolverParams<Fmt, NMAX>& P, const SolverColumns<Fmt, NMAX, ROWS>& C, int n,
+                      typename Fmt::qd_t* qd, typename Fmt::tacc_t* racc, Status& st) {
+  using bfm_t = typename Fmt::bfm_t;
+  using cgy_t = typename Fmt::cgy_t;
+  using cgx_t = typename Fmt::cgx_t;
+  using cgr_t = typename Fmt::cgr_t;
+  using step_t = typename Fmt::step_t;
+  using qd_t = typename Fmt::qd_t;
+  using tacc_t = typename Fmt::tacc_t;
+  using cge_t = typename Fmt::cge_t;
+  using G = decltype(dot_exact<Fmt, ROWS>(C.js[0], static_cast<const bfm_t*>(nullptr), 0));
+  using Y = decltype(columns_times<Fmt, NMAX, ROWS>(C.js, static_cast<const bfm_t*>(nullptr), 0, 0));
+  using U = decltype(bfm_t{} + bfm_t{});
+  constexpr int NONE = -(1 << 20);
+  const int rows = C.rows;
+  const auto one = one_of<typename Fmt::mu_t>();
+  bool use[NMAX];
+  bfm_t rn[ROWS], s[NMAX], p[NMAX], w[ROWS], z[ROWS], sc;
+  cgr_t rr[ROWS];                       // residual of the recurrence, times 2^-k0
+  cgx_t d[NMAX], dlo[NMAX], dhi[NMAX];  // increment and its box, times 2^-k0
+  G g[NMAX];
+  Y y[ROWS];
+  U u[NMAX];
+  int k0 = 0, kr = 0, ks = 0, kp = 0, kw = 0, kz = 0, kd = 0, kn = 0;
+  cgy_t yw{};                           // 2^(kd + 1) / |w|^2, in [1, 2]
+  if (!block_norm<Fmt, ROWS>(racc, rows, rn, k0, st)) return;
+  for (int a = 0; a < ROWS; ++a) rr[a] = a < rows ? cvt_shr<cgr_t>(racc[a], k0, st) : cgr_t{};
+  for (int i = 0; i < NMAX; ++i) {
+    d[i] = cgx_t{};
+    if (i >= n) continue;
+    dlo[i] = cvt_shr<cgx_t>(C.lo[i] - qd[i], k0, st);
+    dhi[i] = cvt_shr<cgx_t>(C.hi[i] - qd[i], k0, st);
+  }
+  for (int it = 0; it < CG_MAX; ++it) {
+    if (it >= P.cg) break;
+    // residual and gradient g = A^T r over the joints in use, in block floating point
+    if (!block_norm<Fmt, ROWS>(rr, rows, rn, kr, st)) break;
+    kr += k0;
+    for (int i = 0; i < NMAX; ++i) {
+      if (i >= n) continue;
+      g[i] = dot_exact<Fmt, ROWS>(C.js[i], rn, rows);
+      if (it == 0)  // the free set: not frozen, and not pushed out of its box by the gradient
+        use[i] = !(P.mu[i] == typename Fmt::mu_t{}) && !(!(C.lo[i] < qd[i]) && g[i] < G{}) &&
+                 !(!(qd[i] < C.hi[i]) && G{} < g[i]);
+      if (!use[i]) g[i] = G{};
+    }
+    if (!block_norm<Fmt, NMAX>(g, n, s, ks, st)) break;
+    // direction: p = s at the first step, then p = s + beta p, beta = -<A s, A p> / |A p|^2 = bt 2^eb
+    if (it == 0) {
+      for (int i = 0; i < NMAX; ++i) p[i] = s[i];
+    } else {
+      for (int a = 0; a < ROWS; ++a)
+        if (a < rows) y[a] = columns_times<Fmt, NMAX, ROWS>(C.js, s, n, a);
+      if (!block_norm<Fmt, ROWS>(y, rows, z, kz, st)) break;
+      const auto bn = dot_exact<Fmt, ROWS>(z, w, rows);
+      int eb = 0;
+      bfm_t bt{};
+      if (block_norm<Fmt, 1>(&bn, 1, &sc, kn, st)) {
+        bt = cvt<bfm_t>(pow2<-1>(-(sc * yw)), st);   // in (-1, 1)
+        eb = kn - kd + kz - kw;
+      }
+      // s + bt p 2^eb, both terms scaled by 2^-E (E: the larger term's exponent), renormalised
+      int kt = NONE;
+      for (int i = 0; i < NMAX; ++i) {
+        if (i >= n) continue;
+        const auto t = bt * p[i];
+        const int ki = t < decltype(t){} ? ilog2(-t) : ilog2(t);
+        kt = ki > kt ? ki : kt;
+      }
+      const int E = (kt > NONE && kt + eb + 1 > 0) ? kt + eb + 1 : 0;
+      for (int i = 0; i < NMAX; ++i)
+        if (i < n) u[i] = cvt_shr<bfm_t>(s[i], E, st) + cvt_shr<bfm_t>(bt * p[i], E - eb, st);
+      if (!block_norm<Fmt, NMAX>(u, n, p, kp, st)) break;
+    }
+    // w = A p, |w|^2 = m 2^(kd + 1) with m in [1/2, 1], yw = 1/m
+    for (int a = 0; a < ROWS; ++a)
+      if (a < rows) y[a] = columns_times<Fmt, NMAX, ROWS>(C.js, p, n, a);
+    if (!block_norm<Fmt, ROWS>(y, rows, w, kw, st)) break;
+    {
+      const auto dd = dot_exact<Fmt, ROWS>(w, w, rows);
+      step_t c{};
+      step_factor<Fmt>(dd, one, c, kd, st);          // c ~ 1 / (dd 2^-kd), error < 2^-13
+      const bfm_t m = cvt_shr<bfm_t>(dd, kd + 1, st);   // [1/2, 1]
+      const auto y0 = pow2<1>(c);                       // ~ 1/m
+      const cge_t e = cvt<cge_t>(one - m * y0, st);
+      yw = cvt<cgy_t>(y0 + y0 * e, st);
+    }
+    // line search: alpha = <w, r> / |w|^2 2^(kr - kw) = at 2^ea
+    const auto an = dot_exact<Fmt, ROWS>(w, rn, rows);
+    if (!block_norm<Fmt, 1>(&an, 1, &sc, kn, st)) break;   // r orthogonal to A p: done
+    const bfm_t at = cvt<bfm_t>(pow2<-1>(sc * yw), st);     // in (-1, 1)
+    const int ea = kn - kd + kr - kw;
+    bool inside = true;
+    cgx_t dn[NMAX];
+    for (int i = 0; i < NMAX; ++i) {
+      dn[i] = d[i];
+      if (i >= n || !use[i]) continue;
+      dn[i] = cvt<cgx_t>(d[i] + cvt_shr<cgx_t>(at * p[i], k0 - ea, st), st);
+      inside = inside && !(dn[i] < dlo[i]) && !(dhi[i] < dn[i]);
+    }
+    if (!inside) break;
+    for (int i = 0; i < NMAX; ++i) d[i] = dn[i];
+    // r -= alpha A p = at w 2^(ea + kw)
+    for (int a = 0; a < ROWS; ++a)
+      if (a < rows) rr[a] = cvt<cgr_t>(rr[a] - cvt_shr<cgr_t>(at * w[a], k0 - ea - kw, st), st);
+  }
+  // q' += d, and the exact residual of what q' really moved
+  for (int i = 0; i < NMAX; ++i) {
+    if (i >= n) continue;
+    const qd_t qn = tmax(C.lo[i], tmin(cvt<qd_t>(qd[i] + cvt_shr<qd_t>(d[i], -k0, st), st), C.hi[i]));
+    const qd_t dq = cvt<qd_t>(qn - qd[i], st);
+    for (int a = 0; a < ROWS; ++a)
+      if (a < rows) racc[a] = cvt<tacc_t>(racc[a] - C.js[i][a] * dq, st);
+    qd[i] = qn;
+  }
+}
+
 // Solve: qd holds the warm start on entry and q' on return; r receives the final scaled residual
 // (C.rows entries).
 template <class Fmt, int NMAX, int ROWS>
@@ -240,6 +422,7 @@ inline void solver_run(const SolverParams<Fmt, NMAX>& P, const SolverColumns<Fmt
       qd[i] = qn;
     }
   }
+  if (P.cg > 0) solver_cg<Fmt, NMAX, ROWS>(P, C, n, qd, racc, st);
   for (int a = 0; a < ROWS; ++a)
     if (a < rows) r[a] = cvt<tw_t>(racc[a], st);
   for (int i = 0; i < NMAX; ++i) {

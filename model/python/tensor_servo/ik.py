@@ -60,6 +60,8 @@ SOLVERS = ("cd", "pinv", "dls")
 LIMITS = ("free", "wrap", "clip")
 #: a target's rotation block R must satisfy max|R^T R - I| <= RIGID_TOL and det R > 0
 RIGID_TOL = 1e-6
+#: most conjugate-direction steps per tick (solver.hpp CG_MAX)
+CG_MAX = 64
 
 
 @dataclass
@@ -82,7 +84,11 @@ class IKParams:
     clip_from_seed: bool = True  # "free": the clip phase starts again from the attempt's seed
     polish_after: int | None = 50  # cd: after this many ticks of an attempt switch to ...
     polish_mu: float | None = None  # ... this relaxation (None: 1.9 for n <= 6 joints, else mu) ...
-    polish_sweeps: int = 60     # ... and this many sweeps (ill-conditioned targets converge slowly)
+    polish_sweeps: int = 60     # ... and this many sweeps (ill-conditioned targets converge slowly) ...
+    polish_cg: int | None = None  # ... followed by this many conjugate-direction steps (solver.hpp
+                                  # solver_cg; None: 2 n, 0: none) ...
+    cg_below: float = 0.1       # ... once the model's error max(|e_p|, L |e_o|) is below this (m)
+    cg: int = 0                 # conjugate-direction steps after the sweeps before the polish
     stall_window: int | None = 100  # every this many ticks of an attempt ...
     stall_ratio: float = 0.95   # ... the model's error must have fallen below this fraction of
                                 # its value at the previous test, or the attempt ends ...
@@ -154,6 +160,7 @@ def _check_params(p: IKParams, max_ticks: int, tol_pos: float, tol_rot: float) -
     pos(tol_pos, "--tol-pos"); pos(tol_rot, "--tol-rot")
     if not isinstance(max_ticks, (int, np.integer)) or max_ticks < 0:
         raise InputError("--max-ticks", f"must be a non-negative integer (got {max_ticks!r})")
+    pos(p.cg_below, "cg_below")
     pos(p.dt, "dt"); pos(p.kdt, "kdt"); pos(p.klim_dt, "klim_dt"); pos(p.L, "L"); pos(p.margin, "margin")
     if p.dt >= 1.0 / 16:
         raise InputError("dt", "must be below 1/16 s")
@@ -163,6 +170,9 @@ def _check_params(p: IKParams, max_ticks: int, tol_pos: float, tol_rot: float) -
         raise InputError("kdt", "K dt must be below 2 and klim dt at most 1")
     if not (isinstance(p.sweeps, (int, np.integer)) and 1 <= p.sweeps <= 1000):
         raise InputError("sweeps", "must be 1..1000")
+    for name, v in (("cg", p.cg), ("polish_cg", 0 if p.polish_cg is None else p.polish_cg)):
+        if not (isinstance(v, (int, np.integer)) and 0 <= v <= CG_MAX):
+            raise InputError(name, f"must be 0..{CG_MAX} conjugate-direction steps (got {v!r})")
     if not (isinstance(p.restarts, (int, np.integer)) and p.restarts >= 0):
         raise InputError("--restarts", "must be a non-negative integer")
     if not (isinstance(p.attempt_ticks, (int, np.integer)) and p.attempt_ticks >= 1):
@@ -252,7 +262,7 @@ class _CDEngine:
 
         K = p.kdt / p.dt
         self.servo = Servo(chain, config, dt=p.dt, L=p.L, kp=K, ko=K, klim=p.klim_dt / p.dt,
-                           sweeps=int(p.sweeps), mu=float(p.mu), vlimits=False)
+                           sweeps=int(p.sweeps), mu=float(p.mu), vlimits=False, cg=int(p.cg))
 
     def step(self, q, quat, pos, tp, tr):
         """(q_next, moved (0/1), converged after the move): the model's test is done before the
@@ -419,8 +429,12 @@ def solve(chain: Chain, targets: np.ndarray, q0: np.ndarray, *, model: str = "fi
     polish = solver == "cd" and p.polish_after is not None
     if polish:
         pp = polish_params(p, n)
-        pol_search = engine(free, pp)
-        pol_clip = pol_search if same else engine(clip_free, pp)
+        pn = dataclasses.replace(pp, cg=0)
+        pol_search = engine(free, pn)
+        pol_clip = pol_search if same else engine(clip_free, pn)
+        if pp.cg:
+            cg_search = engine(free, pp)
+            cg_clip = cg_search if same else engine(clip_free, pp)
     if solver == "cd":
         tq = np.array([matrix_to_quat(t[:3, :3]) for t in T])
     else:
@@ -468,14 +482,25 @@ def solve(chain: Chain, targets: np.ndarray, q0: np.ndarray, *, model: str = "fi
         phase[again] = SEARCH
         phase[np.setdiff1d(idx, again)] = FAILED
 
-    groups = [(SEARCH, eng_search, free, False), (CLIP, eng_clip, clip_free, False)]
+    # engines: (phase, engine, free joints, polish, conjugate-direction refinement)
+    groups = [(SEARCH, eng_search, free, False, False), (CLIP, eng_clip, clip_free, False, False)]
+    use_cg = polish and pp.cg > 0
     if polish:
-        groups += [(SEARCH, pol_search, free, True), (CLIP, pol_clip, clip_free, True)]
+        groups += [(SEARCH, pol_search, free, True, False), (CLIP, pol_clip, clip_free, True, False)]
+    if use_cg:
+        groups += [(SEARCH, cg_search, free, True, True), (CLIP, cg_clip, clip_free, True, True)]
+    near = np.zeros(N, dtype=bool)           # polish: close enough for the refinement
     for _ in range(max_ticks + 1):
-        for ph, eng, mask, pol in groups:
+        if use_cg:
+            pidx = np.nonzero((phase <= CLIP) & (att_ticks >= p.polish_after))[0]
+            if len(pidx):
+                near[pidx] = merr(q[pidx], pidx) < p.cg_below
+        for ph, eng, mask, pol, cg in groups:
             idx = np.nonzero(phase == ph)[0]
             if polish:
                 idx = idx[(att_ticks[idx] >= p.polish_after) == pol]
+            if use_cg and pol:
+                idx = idx[near[idx] == cg]
             if not len(idx):
                 continue
             qn, mv, c = eng.step(q[idx], tq[idx], tpos[idx], tp, tr)
@@ -533,7 +558,8 @@ def solve(chain: Chain, targets: np.ndarray, q0: np.ndarray, *, model: str = "fi
 def polish_params(p: IKParams, n: int) -> IKParams:
     """The parameters of the polish engine (after ``polish_after`` ticks of an attempt)."""
     mu = p.polish_mu if p.polish_mu is not None else (1.9 if n <= 6 else p.mu)
-    return dataclasses.replace(p, mu=mu, sweeps=p.polish_sweeps)
+    cg = p.polish_cg if p.polish_cg is not None else 2 * n
+    return dataclasses.replace(p, mu=mu, sweeps=p.polish_sweeps, cg=cg)
 
 
 class _ModelError:

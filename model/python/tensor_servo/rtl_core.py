@@ -187,6 +187,8 @@ class RtlServo:
             raise InputError("--sweeps", f"the core runs 1..{SWEEPS_MAX} sweeps per tick (got {sw})")
         if int(params.get("warm_leak", 0)) > LEAK_MAX:
             raise InputError("--warm", f"the core's warm-start leak is 0..{LEAK_MAX}")
+        if int(params.get("cg", 0)) != 0:
+            raise InputError("cg", "the core has no conjugate-direction refinement (an offline IK option): use cg = 0")
         self.model = Servo(chain, config, dt=dt, **params)   # quantisation and config words
         try:
             self.raw = self.model._s.config_raw()

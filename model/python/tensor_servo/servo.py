@@ -31,6 +31,7 @@ def default_params(chain: Chain, dt: float) -> dict:
         "mu": [1.5] * chain.n, "mode": "A", "feedforward": True, "controlled": -1, "setpoint_frame": -1,
         "vlimits": True, "weights": None,
         "warm_leak": 0,  # leak of the warm start inside the tick (track.py applies its own by default)
+        "cg": 0,  # conjugate-direction steps after the sweeps (offline IK only; the core has none)
     }
 
 

@@ -1,5 +1,6 @@
 // Audit of multiplier operand widths (built with -DTS_AUDIT_MUL as its own program, see Makefile):
-// runs FK, every Jacobian form, the servo tick in both error modes and the configuration step,
+// runs FK, every Jacobian form, the servo tick in both error modes (with the IK's conjugate-direction
+// refinement) and the configuration step,
 // and checks the widest multiplier operand: <= 18 bits in the compact configuration (one
 // MULT18X18D / DSP48E1 per product) and <= 36 in the default one (4 MULT18X18D).
 #include <cstdio>
@@ -39,6 +40,7 @@ int run() {
       P.solver.L = Fmt::lchar_t::from_double(0.5, st);
       P.solver.klim = Fmt::klim_t::from_double(500, st);
       P.solver.sweeps = 3;
+      P.solver.cg = 2 * ch.n;  // the offline IK's refinement too (model only, same operand rule)
       for (int i = 0; i < ch.n; ++i) {
         P.solver.mu[i] = Fmt::mu_t::from_double(1.5, st);
         P.solver.limited[i] = true;
