@@ -8,8 +8,8 @@ localparam TS_BFM_W = (CONFIG == 0) ? 27 : 18;  // bfm_t: <27,2> / <18,2>
 localparam TS_BFM_F = (CONFIG == 0) ? 25 : 16;
 localparam TS_CGE_W = (CONFIG == 0) ? 27 : 18;  // cge_t: <27,-10> / <18,-10>
 localparam TS_CGE_F = (CONFIG == 0) ? 37 : 28;
-localparam TS_CGR_W = (CONFIG == 0) ? 60 : 48;  // cgr_t: <60,2> / <48,2>
-localparam TS_CGR_F = (CONFIG == 0) ? 58 : 46;
+localparam TS_CGR_W = (CONFIG == 0) ? 60 : 48;  // cgr_t: <60,4> / <48,4>
+localparam TS_CGR_F = (CONFIG == 0) ? 56 : 44;
 localparam TS_CGX_W = (CONFIG == 0) ? 60 : 48;  // cgx_t: <60,30> / <48,24>
 localparam TS_CGX_F = (CONFIG == 0) ? 30 : 24;
 localparam TS_CGY_W = (CONFIG == 0) ? 27 : 18;  // cgy_t: <27,3> / <18,3>

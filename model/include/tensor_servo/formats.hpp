@@ -123,7 +123,7 @@ struct FmtDefaultT {
   using cgy_t = N<27, 3, ST_OVF_SOLVER>;       // IK refinement: refined reciprocal, [1, 2]
   using cge_t = N<27, -10, ST_OVF_SOLVER>;     // IK refinement: Newton error 1 - m y, |.| < 2^-12
   using cgx_t = N<60, 30, ST_OVF_SOLVER>;      // IK refinement: increment of q' / 2^k0 (|r0| < 2^k0)
-  using cgr_t = N<60, 2, ST_OVF_SOLVER>;       // IK refinement: residual / 2^k0, |.| < 2
+  using cgr_t = N<60, 4, ST_OVF_SOLVER>;       // IK refinement: residual / 2^k0, |.| < sqrt(24) < 8
   using klim_t = N<27, 15, ST_OVF_CONST>;      // limit-approach gain (1/s)
   using qdiff_t = N<33, 5, ST_OVF_SOLVER>;     // limit - q, exact (33-bit operand: 4 MULT18X18D)
   using gain_t = N<27, 15, ST_OVF_CONST>;      // servo gains K_p, K_o (1/s)
@@ -181,7 +181,7 @@ struct FmtCompactT {
   using cgy_t = N<18, 3, ST_OVF_SOLVER>;
   using cge_t = N<18, -10, ST_OVF_SOLVER>;
   using cgx_t = N<48, 24, ST_OVF_SOLVER>;
-  using cgr_t = N<48, 2, ST_OVF_SOLVER>;
+  using cgr_t = N<48, 4, ST_OVF_SOLVER>;
   using klim_t = N<18, 15, ST_OVF_CONST>;
   using qdiff_t = N<18, 5, ST_OVF_SOLVER>;     // limit - q rounded to an 18-bit operand
   using gain_t = N<18, 15, ST_OVF_CONST>;

@@ -279,7 +279,7 @@ inline void solver_cg(const SolverParams<Fmt, NMAX>& P, const SolverColumns<Fmt,
   const auto one = one_of<typename Fmt::mu_t>();
   bool use[NMAX];
   bfm_t rn[ROWS], s[NMAX], p[NMAX], w[ROWS], z[ROWS], sc;
-  cgr_t rr[ROWS];                       // residual of the recurrence, times 2^-k0
+  cgr_t rr[ROWS];                       // residual of the recurrence, times 2^-k0 (|rr| <= |rr_0| < sqrt(rows))
   cgx_t d[NMAX], dlo[NMAX], dhi[NMAX];  // increment and its box, times 2^-k0
   G g[NMAX];
   Y y[ROWS];
@@ -291,8 +291,11 @@ inline void solver_cg(const SolverParams<Fmt, NMAX>& P, const SolverColumns<Fmt,
   for (int i = 0; i < NMAX; ++i) {
     d[i] = cgx_t{};
     if (i >= n) continue;
-    dlo[i] = cvt_shr<cgx_t>(C.lo[i] - qd[i], k0, st);
-    dhi[i] = cvt_shr<cgx_t>(C.hi[i] - qd[i], k0, st);
+    // a bound beyond cgx_t's range is clipped to it: that can only end the refinement earlier,
+    // so it raises no flag (scratch status)
+    Status clip;
+    dlo[i] = cvt_shr<cgx_t>(C.lo[i] - qd[i], k0, clip);
+    dhi[i] = cvt_shr<cgx_t>(C.hi[i] - qd[i], k0, clip);
   }
   for (int it = 0; it < CG_MAX; ++it) {
     if (it >= P.cg) break;

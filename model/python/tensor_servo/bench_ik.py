@@ -378,6 +378,8 @@ STUDY_VARIANTS = [
     ("limits = wrap (full-turn joints only)", {"limits": "wrap"}),
     ("free, clip phase from the clamped answer", {"clip_from_seed": False}),
     ("no polish (30 sweeps, mu 1.6 throughout)", {"polish_after": None}),
+    ("polish without the conjugate-direction refinement", {"polish_cg": 0}),
+    ("refinement from 1e-3 m (cg_below)", {"cg_below": 1e-3}),
     ("no stall test", {"stall_window": None}),
     ("dt = 1/32 (K = 32: V and q' saturate on far seeds)", {"dt": 1 / 32}),
     ("L = 0.5 m", {"L": 0.5}),
