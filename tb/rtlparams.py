@@ -48,6 +48,40 @@ def quantize_const(x: float, cfg: str, name: str) -> int:
     return max(-(1 << (w - 1)), min((1 << (w - 1)) - 1, r))
 
 
+def reset_joint(cfg: str) -> dict:
+    """A joint block of the core's register map at its reset values (rtl/ts_servo_regs.rdl)."""
+    one = quantize_const(1.0, cfg, "quat_t")
+    return {"jcfg": 0, "qo": [one, 0, 0, 0], "po": [0, 0, 0], "axis": [0, 0, one],
+            "scale": quantize_const(1.0, cfg, "scale_t"), "lower": 0, "upper": 0, "vmax": 0,
+            "mu": quantize_const(1.5, cfg, "mu_t")}
+
+
+def core_raw(chain, cfg: str, nmax: int, servo: dict, mode: int = 0, sweeps: int = 10, leak: int = 5) -> dict:
+    """The register words software writes for a chain (every value rounded to its format, mu 1.5),
+    the servo words ``servo`` (key -> (format, value)), ``nmax`` joint blocks (unused ones at reset).
+    The words the core benches commit (tb/ts_core_commit, tb/ts_servo_core)."""
+    qv = lambda v: [quantize_const(float(x), cfg, "quat_t") for x in v]  # noqa: E731
+    lv = lambda v: [quantize_const(float(x), cfg, "len_t") for x in v]  # noqa: E731
+    raw = {"n": chain.n, "mode": mode, "sweeps": sweeps, "warm_leak": leak,
+           "base_q": qv(chain.base.quat_wxyz), "base_p": lv(chain.base.xyz),
+           "tool_q": qv(chain.tool.quat_wxyz), "tool_p": lv(chain.tool.xyz), "joints": []}
+    for k, (f, x) in servo.items():
+        raw[k] = quantize_const(x, cfg, f)
+    for j in chain.joints:
+        lim = j.limits
+        jcfg = (1 if j.prismatic else 0) | (2 if lim.bounded else 0) | (4 if lim.velocity is not None else 0)
+        raw["joints"].append({
+            "jcfg": jcfg, "qo": qv(j.origin.quat_wxyz), "po": lv(j.origin.xyz), "axis": qv(j.axis),
+            "scale": quantize_const(j.scale, cfg, "scale_t"),
+            "lower": quantize_const(lim.lower, cfg, "angle_t") if lim.bounded else 0,
+            "upper": quantize_const(lim.upper, cfg, "angle_t") if lim.bounded else 0,
+            "vmax": quantize_const(lim.velocity, cfg, "qd_t") if lim.velocity is not None else 0,
+            "mu": quantize_const(1.5, cfg, "mu_t")})
+    while len(raw["joints"]) < nmax:
+        raw["joints"].append(reset_joint(cfg))
+    return raw
+
+
 def mul_lat(aw: int, bw: int) -> int:
     """ts_mul latency (rtl/ts_common.vh ts_mul_lat)."""
     return 3 + (aw > 18 or bw > 18) + (aw > 18) + (bw > 18)

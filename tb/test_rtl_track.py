@@ -12,7 +12,7 @@ second half of the run (docs/numerics.md, tracking).
 
 Ticks per run: TS_RTL_TICKS (default 150 at 10 sweeps); ``make soak`` runs 10,000 ticks per chain
 and configuration at 2 sweeps (TS_RTL_TICKS=10000 TS_RTL_SWEEPS=2); TS_SEED replays the random
-chain.  The CLI test checks ``tservo track --model rtl`` output files against ``--model fixed``
+chain.  The 20-joint chain runs through the core built with NMAX = 20.  The CLI test checks ``tservo track --model rtl`` output files against ``--model fixed``
 and its one-line errors.
 """
 from __future__ import annotations
@@ -92,6 +92,21 @@ def test_rtl_core_tracks_bit_identical_to_the_model(name, cfg):
     assert len(cyc) == NT and min(cyc) > 0
     print(f"[rtl track] {name} {cfg} n={ch.n} NMAX={tick.core.nmax} (seed {SEED}): {NT} ticks identical to the model; "
           f"{SWEEPS} sweeps: {min(cyc)}-{max(cyc)} cycles per tick; flags {int(np.bitwise_or.reduce(rt.flags)):#x}")
+
+
+def test_rtl_core_above_nmax_8_tracks_bit_identical():
+    """The 20-joint chain through the whole core built with NMAX = 20 (compact, 2 sweeps, 30
+    ticks; TS_RTL_TICKS scales it): every output identical to the model."""
+    ch = robots.load("chain20")
+    nt = max(30, NT // 5)
+    q0 = start(ch, "chain20", np.random.default_rng(SEED + 2))
+    T, V = path_for(ch, q0, nt)
+    res, tick, _ = run_model("fixed", ch, T, V, q0, Plant(q0, DT), config="compact", dt=DT, sweeps=2)
+    rt, tick, _ = run_model("rtl", ch, T, V, q0, Plant(q0, DT), config="compact", dt=DT, sweeps=2)
+    assert tick.core.nmax == 20
+    for k in ("q", "qd", "flags", "pos_err", "rot_err"):
+        assert np.array_equal(getattr(res, k), getattr(rt, k)), (k, SEED)
+    print(f"[rtl track] chain20 compact NMAX=20: {nt} ticks identical; {min(tick.core.cycles)} cycles per tick")
 
 
 @pytest.mark.parametrize("cfg", ["default", "compact"])

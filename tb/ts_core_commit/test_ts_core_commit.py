@@ -52,11 +52,7 @@ def rmin(cfg, name):
     return -(1 << (fw(cfg, name)[0] - 1))
 
 
-def q(x: float, cfg: str, name: str) -> int:
-    """Raw value of x in a format (round half up, saturate): what software writes."""
-    w, f = fw(cfg, name)
-    r = math.floor(math.ldexp(x, f) + 0.5)
-    return max(-(1 << (w - 1)), min((1 << (w - 1)) - 1, r))
+q = rtlparams.quantize_const   # raw value of x in a format (round half up, saturate): what software writes
 
 
 def expected_params(cfg: str) -> dict:
@@ -118,35 +114,10 @@ SERVO = {"kp": ("gain_t", 300.0), "ko": ("gain_t", 300.0), "lchar": ("lchar_t", 
          "klim": ("klim_t", 500.0), "dt": ("dt_t", 0.001)}
 
 
-def reset_joint(cfg: str) -> dict:
-    one = q(1.0, cfg, "quat_t")
-    return {"jcfg": 0, "qo": [one, 0, 0, 0], "po": [0, 0, 0], "axis": [0, 0, one],
-            "scale": q(1.0, cfg, "scale_t"), "lower": 0, "upper": 0, "vmax": 0, "mu": q(1.5, cfg, "mu_t")}
-
-
 def raw_from_chain(chain, cfg: str) -> dict:
-    """The register words software writes for a chain (every value rounded to its format), the
-    safe servo defaults of docs/registers.md, NMAX joint blocks (the unused ones at reset)."""
-    qv = lambda v: [q(float(x), cfg, "quat_t") for x in v]  # noqa: E731
-    lv = lambda v: [q(float(x), cfg, "len_t") for x in v]  # noqa: E731
-    raw = {"n": chain.n, "mode": 0, "sweeps": 10, "warm_leak": 5,
-           "base_q": qv(chain.base.quat_wxyz), "base_p": lv(chain.base.xyz),
-           "tool_q": qv(chain.tool.quat_wxyz), "tool_p": lv(chain.tool.xyz), "joints": []}
-    for k, (fmt, x) in SERVO.items():
-        raw[k] = q(x, cfg, fmt)
-    for j in chain.joints:
-        lim = j.limits
-        jcfg = (1 if j.prismatic else 0) | (2 if lim.bounded else 0) | (4 if lim.velocity is not None else 0)
-        raw["joints"].append({
-            "jcfg": jcfg, "qo": qv(j.origin.quat_wxyz), "po": lv(j.origin.xyz), "axis": qv(j.axis),
-            "scale": q(j.scale, cfg, "scale_t"),
-            "lower": q(lim.lower, cfg, "angle_t") if lim.bounded else 0,
-            "upper": q(lim.upper, cfg, "angle_t") if lim.bounded else 0,
-            "vmax": q(lim.velocity, cfg, "qd_t") if lim.velocity is not None else 0,
-            "mu": q(1.5, cfg, "mu_t")})
-    while len(raw["joints"]) < NMAX:
-        raw["joints"].append(reset_joint(cfg))
-    return raw
+    """The register words software writes for a chain (rtlparams.core_raw): the safe servo
+    defaults of docs/registers.md, NMAX joint blocks (the unused ones at reset)."""
+    return rtlparams.core_raw(chain, cfg, NMAX, SERVO)
 
 
 def copy_raw(raw: dict) -> dict:

@@ -40,37 +40,12 @@ def fw(cfg, name):
     return rtlparams.fmt(cfg, name)
 
 
-def qz(x: float, cfg: str, name: str) -> int:
-    w, f = fw(cfg, name)
-    r = math.floor(math.ldexp(x, f) + 0.5)
-    return max(-(1 << (w - 1)), min((1 << (w - 1)) - 1, r))
+qz = rtlparams.quantize_const
 
 
 def raw_from_chain(chain, cfg: str, mode: int = 0, sweeps: int = 10, leak: int = 5) -> dict:
-    """Register words of a chain (as tb/ts_core_commit), unused joint blocks at their reset."""
-    qv = lambda v: [qz(float(x), cfg, "quat_t") for x in v]  # noqa: E731
-    lv = lambda v: [qz(float(x), cfg, "len_t") for x in v]  # noqa: E731
-    raw = {"n": chain.n, "mode": mode, "sweeps": sweeps, "warm_leak": leak,
-           "base_q": qv(chain.base.quat_wxyz), "base_p": lv(chain.base.xyz),
-           "tool_q": qv(chain.tool.quat_wxyz), "tool_p": lv(chain.tool.xyz), "joints": []}
-    for k, (f, x) in SERVO.items():
-        raw[k] = qz(x, cfg, f)
-    for j in chain.joints:
-        lim = j.limits
-        jcfg = (1 if j.prismatic else 0) | (2 if lim.bounded else 0) | (4 if lim.velocity is not None else 0)
-        raw["joints"].append({
-            "jcfg": jcfg, "qo": qv(j.origin.quat_wxyz), "po": lv(j.origin.xyz), "axis": qv(j.axis),
-            "scale": qz(j.scale, cfg, "scale_t"),
-            "lower": qz(lim.lower, cfg, "angle_t") if lim.bounded else 0,
-            "upper": qz(lim.upper, cfg, "angle_t") if lim.bounded else 0,
-            "vmax": qz(lim.velocity, cfg, "qd_t") if lim.velocity is not None else 0,
-            "mu": qz(1.5, cfg, "mu_t")})
-    one = qz(1.0, cfg, "quat_t")
-    while len(raw["joints"]) < NMAX:
-        raw["joints"].append({"jcfg": 0, "qo": [one, 0, 0, 0], "po": [0, 0, 0], "axis": [0, 0, one],
-                              "scale": qz(1.0, cfg, "scale_t"), "lower": 0, "upper": 0, "vmax": 0,
-                              "mu": qz(1.5, cfg, "mu_t")})
-    return raw
+    """Register words of a chain (rtlparams.core_raw, as tb/ts_core_commit), this bench's gains."""
+    return rtlparams.core_raw(chain, cfg, NMAX, SERVO, mode=mode, sweeps=sweeps, leak=leak)
 
 
 def start_q(chain, cfg: str, rng) -> list[int]:

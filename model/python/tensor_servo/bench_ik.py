@@ -387,6 +387,13 @@ STUDY_VARIANTS = [
 ]
 
 
+def _solve_cell(ch: Chain, T: np.ndarray, Q0: np.ndarray, model: str, kw: dict):
+    """ik.solve with overrides kw; (result, "success loose / tight" in %)."""
+    r = ik.solve(ch, T, Q0, model=model, **kw)
+    sc = score(ch, T, r.q)
+    return r, f"{100 * sc['loose'].mean():.1f} / {100 * sc['tight'].mean():.1f}"
+
+
 def study(n_targets: int = 500, chains: list[str] | None = None, seed: int = 11, model: str = "fixed",
           progress=None) -> str:
     """The parameter / limit-strategy study of docs/ik.md: one markdown row per chain and variant,
@@ -400,11 +407,32 @@ def study(n_targets: int = 500, chains: list[str] | None = None, seed: int = 11,
         for label, kw in STUDY_VARIANTS:
             cells = []
             for kind in ("near", "random"):
-                r = ik.solve(ch, T, seeds[kind], model=model, **kw)
-                sc = score(ch, T, r.q)
-                cells.append(f"{100 * sc['loose'].mean():.1f} / {100 * sc['tight'].mean():.1f} | {np.median(r.ticks):g}")
+                r, cell = _solve_cell(ch, T, seeds[kind], model, kw)
+                cells.append(f"{cell} | {np.median(r.ticks):g}")
             out.append(f"| {name} | {label} | " + " | ".join(cells) + " |")
             say(out[-1])
+    return "\n".join(out)
+
+
+GATE_THRESHOLDS = (1e-3, 1e-2, 3e-2, 1e-1, 3e-1)
+
+
+def gate_study(n_targets: int = 1000, chains: list[str] | None = None, seed: int = 2026, progress=None) -> str:
+    """The refinement's gate (docs/ik.md, "Ill-conditioned targets"): success loose / tight (%) on
+    the benchmark's problems without the refinement and with it from each ``cg_below`` threshold,
+    in double and default fixed point."""
+    say = progress or (lambda *a: None)
+    cols = [("none", {"polish_cg": 0})] + [(f"{t:g}", {"cg_below": t}) for t in GATE_THRESHOLDS]
+    out = ["| chain, number type, seeds | " + " | ".join(c for c, _ in cols) + " |",
+           "|---|" + "---|" * len(cols)]
+    for name in chains or ["ur5", "panda"]:
+        ch = robots.load(name)
+        T, seeds = problems(ch, n_targets, seed)
+        for model in ("float", "fixed"):
+            for kind in ("near", "random"):
+                cells = [_solve_cell(ch, T, seeds[kind], model, kw)[1] for _, kw in cols]
+                out.append(f"| {name}, {'double' if model == 'float' else 'fixed'}, {kind} | " + " | ".join(cells) + " |")
+                say(out[-1])
     return "\n".join(out)
 
 
@@ -419,11 +447,13 @@ def _cpu() -> str:
     return platform.processor() or "unknown CPU"
 
 
-if __name__ == "__main__":  # python -m tensor_servo.bench_ik [N] | python -m tensor_servo.bench_ik study [N]
+if __name__ == "__main__":  # python -m tensor_servo.bench_ik [N] | ... study [N] | ... gate [N]
     import sys
 
     if len(sys.argv) > 1 and sys.argv[1] == "study":
         study(int(sys.argv[2]) if len(sys.argv) > 2 else 500, progress=print)
+    elif len(sys.argv) > 1 and sys.argv[1] == "gate":
+        print(gate_study(int(sys.argv[2]) if len(sys.argv) > 2 else 1000, progress=print))
     else:
         n = int(sys.argv[1]) if len(sys.argv) > 1 else 1000
         table, v = bench_ik(n, progress=print)
