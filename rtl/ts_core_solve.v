@@ -519,11 +519,20 @@ module ts_core_solve #(
   ts_resize #(.IN_W(ACW), .LSH(0), .OUT_W(GW)) u_gw (.in(acc), .out(g_w));
   wire signed [GXW-1:0] g_x;
   ts_resize #(.IN_W(GW), .LSH(GLS), .OUT_W(GXW)) u_gx (.in(g_w), .out(g_x));
+  // The shift and its rounding half come from joint col's k_i, registered every cycle: S_GSH
+  // follows the dot burst of the same col, so the variable-index read and the decoder leave the
+  // path into gsh_q (no cycle added).
   wire signed [9:0] t_s = {{(10 - KW){kst[col][KW-1]}}, kst[col]} + TOFF10;
   wire [6:0] t_u = t_s[6:0];
   wire [GXW-1:0] one_g = {{(GXW - 1){1'b0}}, 1'b1};
   wire signed [GXW-1:0] half_g = (t_u == 7'd0) ? {GXW{1'b0}} : $signed(one_g << (t_u - 7'd1));
-  wire signed [GXW-1:0] gsh = (g_x + half_g) >>> t_u;
+  reg  [6:0] t_uq;
+  reg  signed [GXW-1:0] half_gq;
+  always @(posedge clk) begin
+    t_uq <= t_u;
+    half_gq <= half_g;
+  end
+  wire signed [GXW-1:0] gsh = (g_x + half_gq) >>> t_uq;
   wire unused_t = ^t_s[9:7];
   wire signed [GKW-1:0] gk_o;
   wire gk_s;
@@ -577,18 +586,31 @@ module ts_core_solve #(
   (* rom_style = "logic" *) reg [RCW-1:0] rom [0:(1 << T)-1];
   initial $readmemh(ROM_FILE, rom);
 
-  // warm start with its leak, clamped into this tick's box
+  // warm start with its leak, clamped into this tick's box.  The leaked value is registered every
+  // cycle (warm_lq): S_WARM follows S_BND3 with the same col, so it sees joint col's value one
+  // cycle old, and the variable-index read, the shift and the subtraction leave the path into
+  // qd[col] (no cycle added).
   wire signed [QD_W-1:0] warm_x = x_warm[col];
   wire signed [QD_W-1:0] warm_sh = warm_x >>> cfg_leak;
   wire signed [QD_W-1:0] warm_l = (cfg_leak == 5'd0) ? warm_x : (warm_x - warm_sh);
-  wire signed [QD_W-1:0] warm_t = (hi_q < warm_l) ? hi_q : warm_l;
+  reg  signed [QD_W-1:0] warm_lq;
+  always @(posedge clk) warm_lq <= warm_l;
+  wire signed [QD_W-1:0] warm_t = (hi_q < warm_lq) ? hi_q : warm_lq;
   wire signed [QD_W-1:0] warm_c = (lo_q < warm_t) ? warm_t : lo_q;
   // sweep step clamp
   wire signed [QD_W-1:0] qn_t = (bhi[col] < qn_o) ? bhi[col] : qn_o;
   wire signed [QD_W-1:0] qn_c = (blo[col] < qn_t) ? qn_t : blo[col];
-  // integration clamp
-  wire signed [ANG_W-1:0] qx_t = (cfg_hi[col] < qx_o) ? cfg_hi[col] : qx_o;
-  wire signed [ANG_W-1:0] qx_c = (cfg_lo[col] < qx_t) ? qx_t : cfg_lo[col];
+  // integration clamp; joint col's limits registered every cycle (S_QNX2 follows S_WAIT with the
+  // same col), so the variable-index reads leave the path into qnext[col] (no cycle added)
+  reg  signed [ANG_W-1:0] lo_cq, hi_cq;
+  reg                     lim_cq;
+  always @(posedge clk) begin
+    lo_cq <= cfg_lo[col];
+    hi_cq <= cfg_hi[col];
+    lim_cq <= cfg_lim[col];
+  end
+  wire signed [ANG_W-1:0] qx_t = (hi_cq < qx_o) ? hi_cq : qx_o;
+  wire signed [ANG_W-1:0] qx_c = (lo_cq < qx_t) ? qx_t : lo_cq;
   // active-limit flags of joint col
   wire lo_hit = !(blo[col] < qd[col]);
   wire hi_hit = !(qd[col] < bhi[col]);
@@ -851,7 +873,7 @@ module ts_core_solve #(
           state <= S_WAIT;
         end
         S_QNX2: begin
-          qnext[col] <= cfg_lim[col] ? qx_c : qx_o;
+          qnext[col] <= lim_cq ? qx_c : qx_o;
           if (qx_s) flags[0] <= 1'b1;
           if (lim_act) flags[16] <= 1'b1;
           if (vlim_act) flags[17] <= 1'b1;
