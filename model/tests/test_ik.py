@@ -82,6 +82,23 @@ def test_conjugate_refinement_finishes_ill_conditioned_targets(model):
     assert r0.ok.mean() < 0.98, r0.ok.mean()
 
 
+def test_refinement_steps_capped_on_long_chains():
+    """A 40-joint chain: the polish's 2n refinement steps are capped at CG_MAX (the model refuses
+    more), so the IK runs; answers stay within the limits."""
+    from tensor_servo.randchain import random_chain
+
+    rng = np.random.default_rng(4)
+    ch = random_chain(rng, 40, offset=(0.02, 0.05))
+    assert ik.polish_params(ik.IKParams(), ch.n).cg == ik.CG_MAX
+    pc = PinChain(ch)
+    qt = ch.random_q(rng, 3)
+    T = np.array([pc.tool_pose(q) for q in qt])
+    q0 = np.clip(qt + rng.uniform(-0.05, 0.05, qt.shape), ch.lower, ch.upper)
+    r = ik.solve(ch, T, q0, model="float", max_ticks=120, polish_after=5)
+    assert_honest(ch, pc, r, T, 1e-6, 1e-5)
+    assert r.pos_err.max() < 1e-3, r.pos_err
+
+
 @pytest.mark.parametrize("name", ["puma560", "panda"])
 def test_compact_loose(name):
     ch, pc, T, q0 = problems(name, 16, seed=6)

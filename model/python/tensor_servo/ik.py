@@ -86,7 +86,7 @@ class IKParams:
     polish_mu: float | None = None  # ... this relaxation (None: 1.9 for n <= 6 joints, else mu) ...
     polish_sweeps: int = 60     # ... and this many sweeps (ill-conditioned targets converge slowly) ...
     polish_cg: int | None = None  # ... followed by this many conjugate-direction steps (solver.hpp
-                                  # solver_cg; None: 2 n, 0: none) ...
+                                  # solver_cg; None: 2 n (at most CG_MAX), 0: none) ...
     cg_below: float = 0.1       # ... once the model's error max(|e_p|, L |e_o|) is below this (m)
     cg: int = 0                 # conjugate-direction steps after the sweeps before the polish
     stall_window: int | None = 100  # every this many ticks of an attempt ...
@@ -558,7 +558,7 @@ def solve(chain: Chain, targets: np.ndarray, q0: np.ndarray, *, model: str = "fi
 def polish_params(p: IKParams, n: int) -> IKParams:
     """The parameters of the polish engine (after ``polish_after`` ticks of an attempt)."""
     mu = p.polish_mu if p.polish_mu is not None else (1.9 if n <= 6 else p.mu)
-    cg = p.polish_cg if p.polish_cg is not None else 2 * n
+    cg = p.polish_cg if p.polish_cg is not None else min(2 * n, CG_MAX)
     return dataclasses.replace(p, mu=mu, sweeps=p.polish_sweeps, cg=cg)
 
 
