@@ -571,12 +571,25 @@ module ts_core_solve #(
   // leading one of d = |Js_i|^2 (>= 0) and the normalised mantissa
   wire [DW-1:0] dval;
   ts_resize #(.IN_W(ACW), .LSH(0), .OUT_W(DW)) u_dv (.in(acc), .out(dval));
-  reg [6:0] msb;
-  integer bb;
+  // in two levels (the leading one of each 8-bit group, then the highest non-empty group): two
+  // short priority chains instead of one DW long (the engine's critical path after the register
+  // changes above)
+  localparam NG = (DW + 7) / 8;
+  wire [NG*8-1:0] dpad = {{(NG * 8 - DW){1'b0}}, dval};
+  reg  [NG*3-1:0] gmsb;
+  reg  [NG-1:0]   gany;
+  reg  [6:0]      msb;
+  integer bb, gg;
   always @* begin
+    for (gg = 0; gg < NG; gg = gg + 1) begin
+      gany[gg] = |dpad[gg*8 +: 8];
+      gmsb[gg*3 +: 3] = 3'd0;
+      for (bb = 0; bb < 8; bb = bb + 1)
+        if (dpad[gg*8 + bb]) gmsb[gg*3 +: 3] = bb[2:0];
+    end
     msb = 7'd0;
-    for (bb = 0; bb < DW; bb = bb + 1)
-      if (dval[bb]) msb = bb[6:0];
+    for (gg = 0; gg < NG; gg = gg + 1)
+      if (gany[gg]) msb = {gg[3:0], gmsb[gg*3 +: 3]};
   end
   wire [DW-1:0] dn = dval << (7'd0 + (DW - 1) - msb);
   wire unused_dn = ^dn[DW-MNF-2:0];
@@ -597,9 +610,14 @@ module ts_core_solve #(
   always @(posedge clk) warm_lq <= warm_l;
   wire signed [QD_W-1:0] warm_t = (hi_q < warm_lq) ? hi_q : warm_lq;
   wire signed [QD_W-1:0] warm_c = (lo_q < warm_t) ? warm_t : lo_q;
-  // sweep step clamp
-  wire signed [QD_W-1:0] qn_t = (bhi[col] < qn_o) ? bhi[col] : qn_o;
-  wire signed [QD_W-1:0] qn_c = (blo[col] < qn_t) ? qn_t : blo[col];
+  // sweep step clamp; joint col's bounds registered every cycle (col is stable through a step)
+  reg  signed [QD_W-1:0] blo_cq, bhi_cq;
+  always @(posedge clk) begin
+    blo_cq <= blo[col];
+    bhi_cq <= bhi[col];
+  end
+  wire signed [QD_W-1:0] qn_t = (bhi_cq < qn_o) ? bhi_cq : qn_o;
+  wire signed [QD_W-1:0] qn_c = (blo_cq < qn_t) ? qn_t : blo_cq;
   // integration clamp; joint col's limits registered every cycle (S_QNX2 follows S_WAIT with the
   // same col), so the variable-index reads leave the path into qnext[col] (no cycle added)
   reg  signed [ANG_W-1:0] lo_cq, hi_cq;
