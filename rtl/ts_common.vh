@@ -19,6 +19,17 @@ function integer ts_mul_lat;
   end
 endfunction
 
+// Latency of ts_mul_bank (products a x b of widths aw x bw, FOLD fold): every product out in one
+// cycle, the last phase's fold - 1 cycles after the first's.
+function integer ts_bank_lat;
+  input integer aw;
+  input integer bw;
+  input integer fold;
+  begin
+    ts_bank_lat = ts_mul_lat(aw, bw) + fold - 1;
+  end
+endfunction
+
 function integer ts_max;
   input integer x;
   input integer y;

@@ -46,6 +46,9 @@ module ts_core_fk #(
   parameter ROM_FILE = "ts_trig_rom_default.mem",
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
   parameter TARGET = "GENERIC",
+  // Products per multiplier of the quaternion product, the offset rotation and the screw
+  // transport (ts_mul_bank); the columns are issued one per FOLD cycles
+  parameter FOLD = 1,
   // Joint index width: derived from NMAX, do not override
   parameter JI_W = (NMAX > 1) ? $clog2(NMAX) : 1,
   // Width of angle_t: derived from CONFIG, do not override
@@ -250,6 +253,11 @@ module ts_core_fk #(
   reg [JI_W:0]   col_in;     // columns issued
   reg [JI_W:0]   col_out;    // columns received
   reg have_pf, have_q2;
+  // cycles until the next column may be issued (the screw transport's II = FOLD)
+  localparam GAP_W = (FOLD > 1) ? $clog2(FOLD) : 1;
+  localparam integer FOLD_M1 = FOLD - 1;
+  localparam [GAP_W-1:0] GAP_MAX = FOLD_M1[GAP_W-1:0];
+  reg [GAP_W-1:0] jgap;
 
   reg signed [Q_W-1:0] qc [0:3];   // Q_{i-1}
   reg signed [P_W-1:0] pc [0:2];   // p_{i-1}
@@ -307,7 +315,7 @@ module ts_core_fk #(
   reg signed [Q_W-1:0] qm_b [0:3];
   wire qm_ovalid, qm_sat;
   wire signed [Q_W-1:0] qm_o [0:3];
-  ts_quat_mul #(.Q_W(Q_W), .Q_F(Q_F), .TARGET(TARGET)) u_qm (
+  ts_quat_mul #(.Q_W(Q_W), .Q_F(Q_F), .TARGET(TARGET), .FOLD(FOLD)) u_qm (
     .clk(clk), .rst(rst), .in_valid(qm_valid),
     .in_a_w(qm_a[0]), .in_a_x(qm_a[1]), .in_a_y(qm_a[2]), .in_a_z(qm_a[3]),
     .in_b_w(qm_b[0]), .in_b_x(qm_b[1]), .in_b_y(qm_b[2]), .in_b_z(qm_b[3]),
@@ -321,7 +329,7 @@ module ts_core_fk #(
   wire signed [P_W-1:0] ro_o [0:2];
   ts_quat_rotate #(
     .Q_W(Q_W), .Q_F(Q_F), .V_W(LN_W), .V_F(LN_F), .T_W(TS_LEN_TMP_W), .T_F(TS_LEN_TMP_F),
-    .O_W(P_W), .O_F(P_F), .INV(0), .TARGET(TARGET)
+    .O_W(P_W), .O_F(P_F), .INV(0), .TARGET(TARGET), .FOLD(FOLD)
   ) u_ro (
     .clk(clk), .rst(rst), .in_valid(ro_valid),
     .in_q_w(qm_a[0]), .in_q_x(qm_a[1]), .in_q_y(qm_a[2]), .in_q_z(qm_a[3]),
@@ -375,7 +383,7 @@ module ts_core_fk #(
   ts_screw_transport #(
     .Q_W(Q_W), .Q_F(Q_F), .UT_W(TS_UVEC_TMP_W), .UT_F(TS_UVEC_TMP_F), .S_W(S_W), .S_F(S_F),
     .P_W(P_W), .P_F(P_F), .L_W(L_W), .L_F(L_F), .JW_W(JW_W), .JW_F(TS_JW_F), .JV_W(JV_W),
-    .JV_F(TS_JV_F), .TARGET(TARGET)
+    .JV_F(TS_JV_F), .TARGET(TARGET), .FOLD(FOLD)
   ) u_st (
     .clk(clk), .rst(rst), .in_valid(st_valid),
     .in_q_w(st_q[0]), .in_q_x(st_q[1]), .in_q_y(st_q[2]), .in_q_z(st_q[3]),
@@ -447,6 +455,7 @@ module ts_core_fk #(
       col_out <= {(JI_W+1){1'b0}};
       have_pf <= 1'b0;
       have_q2 <= 1'b0;
+      jgap <= {GAP_W{1'b0}};
       qm_valid <= 1'b0;
       ro_valid <= 1'b0;
       st_valid <= 1'b0;
@@ -540,6 +549,7 @@ module ts_core_fk #(
               out_tool_p_x <= pf_cur[0]; out_tool_p_y <= pf_cur[1]; out_tool_p_z <= pf_cur[2];
               col_in <= {(JI_W+1){1'b0}};
               col_out <= {(JI_W+1){1'b0}};
+              jgap <= {GAP_W{1'b0}};
               state <= (c_n == {(JI_W+1){1'b0}}) ? S_DONE : S_JAC;
             end
           end else if (!c_pr[ji]) begin
@@ -598,12 +608,17 @@ module ts_core_fk #(
           end
         end
         S_JAC: begin
-          // one column per cycle
-          st_valid <= 1'b1;
+          // one column per FOLD cycles (the screw transport's II)
           st_fk <= 1'b0;
-          st_j <= col_in[JI_W-1:0];
-          col_in <= col_in + 1'b1;
-          if (last_col_in) state <= S_JWAIT;
+          if (jgap == {GAP_W{1'b0}}) begin
+            st_valid <= 1'b1;
+            st_j <= col_in[JI_W-1:0];
+            col_in <= col_in + 1'b1;
+            jgap <= GAP_MAX;
+            if (last_col_in) state <= S_JWAIT;
+          end else begin
+            jgap <= jgap - 1'b1;
+          end
         end
         S_JWAIT: begin
           // every column received (and every joint-quaternion and d result, which the last

@@ -20,7 +20,7 @@
 // registered at the start edge).  out_flags: the model's Status bits this evaluation raises
 // (bit 3 ovf_quat, 4 ovf_pos, 6 ovf_jac, 9 ovf_servo), sticky from in_start to the next in_start,
 // including the flags of the column port below.
-// Column port (II = 1, latency COL_LAT): a root-basis Jacobian column (omega: jw_t, v: jv_t, as
+// Column port (II = FOLD, latency COL_LAT): a root-basis Jacobian column (omega: jw_t, v: jv_t, as
 // ts_core_fk's column port gives it) in, the column in the basis the error uses out: mode B
 // rotates both halves by conj(Q_P) (rotate<jw_t, jw_tmp_t, INV>, rotate<jv_t, jv_tmp_t, INV>:
 // ts::jacobian with basis = tool), mode A passes it through (same latency).  It uses the tool
@@ -38,6 +38,9 @@ module ts_core_law #(
   parameter ROM_FILE = "ts_rotvec_rom_default.mem",
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
   parameter TARGET = "GENERIC",
+  // Products per multiplier of the quaternion product and the column rotations (ts_mul_bank);
+  // the column port's II
+  parameter FOLD = 1,
   // Width of quat_t: derived from CONFIG, do not override
   parameter Q_W = (CONFIG == 0) ? 27 : 18,
   // Width of pos_t: derived from CONFIG, do not override
@@ -253,7 +256,7 @@ module ts_core_law #(
       assign qm_b[gi] = r_mb ? uq[gi] : cq[gi];
     end
   endgenerate
-  ts_quat_mul #(.Q_W(Q_W), .Q_F(Q_F), .TARGET(TARGET)) u_qm (
+  ts_quat_mul #(.Q_W(Q_W), .Q_F(Q_F), .TARGET(TARGET), .FOLD(FOLD)) u_qm (
     .clk(clk), .rst(rst), .in_valid(b0),
     .in_a_w(qm_a[0]), .in_a_x(qm_a[1]), .in_a_y(qm_a[2]), .in_a_z(qm_a[3]),
     .in_b_w(qm_b[0]), .in_b_x(qm_b[1]), .in_b_y(qm_b[2]), .in_b_z(qm_b[3]),
@@ -688,13 +691,13 @@ module ts_core_law #(
   end
 
   // ---- column port ----------------------------------------------------------------------------------
-  localparam COL_LAT = ts_mul_lat(Q_W, JW_W) + ts_mul_lat(Q_W, TS_JW_TMP_W) + 3 + 2 * RL;
+  localparam COL_LAT = ts_bank_lat(Q_W, JW_W, FOLD) + ts_bank_lat(Q_W, TS_JW_TMP_W, FOLD) + 3 + 2 * RL;
   wire col_ovalid, col_ovalid_v, col_sw, col_sv;
   wire signed [JW_W-1:0] cw_o [0:2];
   wire signed [JV_W-1:0] cv_o [0:2];
   ts_quat_rotate #(
     .Q_W(Q_W), .Q_F(Q_F), .V_W(JW_W), .V_F(TS_JW_F), .T_W(TS_JW_TMP_W), .T_F(TS_JW_TMP_F),
-    .O_W(JW_W), .O_F(TS_JW_F), .INV(1), .TARGET(TARGET)
+    .O_W(JW_W), .O_F(TS_JW_F), .INV(1), .TARGET(TARGET), .FOLD(FOLD)
   ) u_cw (
     .clk(clk), .rst(rst), .in_valid(in_col_valid),
     .in_q_w(tq[0]), .in_q_x(tq[1]), .in_q_y(tq[2]), .in_q_z(tq[3]),
@@ -702,7 +705,7 @@ module ts_core_law #(
     .out_valid(col_ovalid), .out_x(cw_o[0]), .out_y(cw_o[1]), .out_z(cw_o[2]), .out_sat(col_sw));
   ts_quat_rotate #(
     .Q_W(Q_W), .Q_F(Q_F), .V_W(JV_W), .V_F(TS_JV_F), .T_W(TS_JV_TMP_W), .T_F(TS_JV_TMP_F),
-    .O_W(JV_W), .O_F(TS_JV_F), .INV(1), .TARGET(TARGET)
+    .O_W(JV_W), .O_F(TS_JV_F), .INV(1), .TARGET(TARGET), .FOLD(FOLD)
   ) u_cv (
     .clk(clk), .rst(rst), .in_valid(in_col_valid),
     .in_q_w(tq[0]), .in_q_x(tq[1]), .in_q_y(tq[2]), .in_q_z(tq[3]),

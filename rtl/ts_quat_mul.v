@@ -4,10 +4,11 @@
 // quat.hpp):
 //   r.w = (aw bw - ax bx) - (ay by + az bz)      r.x = (aw bx + ax bw) + (ay bz - az by)
 //   r.y = (aw by - ax bz) + (ay bw + az bx)      r.z = (aw bz + ax by) - (ay bx - az bw)
-// 16 registered products (ts_mul), a registered pairwise adder tree (2 levels, exact), one
-// rounding/saturation stage per component (ts_round_sat: AP_RND, AP_SAT).
-// Latency ts_mul_lat(Q_W, Q_W) + 4 cycles, II = 1, no back-pressure.  out_sat = 1 when any
-// component saturated (the model raises ST_OVF_QUAT).
+// 16 registered products (ts_mul_bank: 16 / FOLD multipliers, rounded up), a registered pairwise
+// adder tree (2 levels, exact), one rounding/saturation stage per component (ts_round_sat: AP_RND,
+// AP_SAT).  Latency ts_bank_lat(Q_W, Q_W, FOLD) + 4 = ts_mul_lat(Q_W, Q_W) + FOLD + 3 cycles,
+// II = FOLD, no back-pressure.  The bits do not depend on FOLD.  out_sat = 1 when any component
+// saturated (the model raises ST_OVF_QUAT).
 // Language: Verilog 2005
 `resetall
 `timescale 1ns / 1ps
@@ -19,7 +20,9 @@ module ts_quat_mul #(
   // Quaternion fraction bits (quat_t W - I)
   parameter Q_F = 25,
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
-  parameter TARGET = "GENERIC"
+  parameter TARGET = "GENERIC",
+  // Products per multiplier (cycles per product, II); 1: 16 multipliers in parallel
+  parameter FOLD = 1
 ) (
   input  wire                  clk,
   input  wire                  rst,
@@ -42,7 +45,7 @@ module ts_quat_mul #(
 
   `include "ts_common.vh"
 
-  localparam ML = ts_mul_lat(Q_W, Q_W);
+  localparam ML = ts_bank_lat(Q_W, Q_W, FOLD);
   // Latency in clock cycles: products, two adder levels, rounding/saturation.
   localparam LATENCY = ML + 2 + ts_round_lat(1);
   localparam P_W = 2 * Q_W;
@@ -54,16 +57,20 @@ module ts_quat_mul #(
 
   // p[4 i + j] = a_i * b_j
   wire signed [P_W-1:0] p [0:15];
+  wire [16*Q_W-1:0] ba, bb;
+  wire [16*P_W-1:0] bp;
   genvar i, j;
   generate
     for (i = 0; i < 4; i = i + 1) begin : g_row
       for (j = 0; j < 4; j = j + 1) begin : g_col
-        ts_mul #(.A_W(Q_W), .B_W(Q_W), .TARGET(TARGET)) u_mul (
-          .clk(clk), .rst(rst), .a(a[i]), .b(b[j]), .p(p[4*i+j])
-        );
+        assign ba[(4*i+j)*Q_W +: Q_W] = a[i];
+        assign bb[(4*i+j)*Q_W +: Q_W] = b[j];
+        assign p[4*i+j] = bp[(4*i+j)*P_W +: P_W];
       end
     end
   endgenerate
+  ts_mul_bank #(.N(16), .FOLD(FOLD), .A_W(Q_W), .B_W(Q_W), .TARGET(TARGET)) u_bank (
+    .clk(clk), .rst(rst), .in_valid(in_valid), .in_a(ba), .in_b(bb), .out_p(bp));
 
   // Level 1: eight pairwise sums, P_W + 1 bits (exact).
   wire signed [P_W:0] e [0:15];

@@ -7,8 +7,10 @@
 // differences (each difference is formed with swapped operands, then rounded), as in the model.
 // The same module serves the model's four kinds by its format parameters (axis, offset, jw, jv).
 // Stage A: 6 products, registered difference, round/saturate -> t.  Stage B: 9 products, two
-// registered adder levels, round/saturate.  Latency ts_mul_lat(Q_W, V_W) + ts_mul_lat(Q_W, T_W) + 7
-// cycles, II = 1.  out_sat = 1 when t or an output component saturated.
+// registered adder levels, round/saturate.  Each stage's products on a ts_mul_bank (6 / FOLD and
+// 9 / FOLD multipliers, rounded up).  Latency ts_bank_lat(Q_W, V_W, FOLD) + ts_bank_lat(Q_W, T_W,
+// FOLD) + 7 cycles, II = FOLD; the bits do not depend on FOLD.  out_sat = 1 when t or an output
+// component saturated.
 // Language: Verilog 2005
 `resetall
 `timescale 1ns / 1ps
@@ -34,7 +36,9 @@ module ts_quat_rotate #(
   // 0: q v q*; 1: q* v q (rotation by the conjugate)
   parameter INV = 0,
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
-  parameter TARGET = "GENERIC"
+  parameter TARGET = "GENERIC",
+  // Products per multiplier (cycles per vector, II); 1: 15 multipliers in parallel
+  parameter FOLD = 1
 ) (
   input  wire                  clk,
   input  wire                  rst,
@@ -55,8 +59,8 @@ module ts_quat_rotate #(
 
   `include "ts_common.vh"
 
-  localparam MLA = ts_mul_lat(Q_W, V_W);
-  localparam MLB = ts_mul_lat(Q_W, T_W);
+  localparam MLA = ts_bank_lat(Q_W, V_W, FOLD);
+  localparam MLB = ts_bank_lat(Q_W, T_W, FOLD);
   // Stage A latency (t available), total latency.
   localparam LA = MLA + 1 + ts_round_lat(1);
   localparam LATENCY = LA + MLB + 2 + ts_round_lat(1);
@@ -65,12 +69,18 @@ module ts_quat_rotate #(
   localparam PA_W = Q_W + V_W;
   wire signed [PA_W-1:0] pa [0:5];
   // Products in the order of the three differences: (y a2, z a1), (z a0, x a2), (x a1, y a0).
-  ts_mul #(.A_W(Q_W), .B_W(V_W), .TARGET(TARGET)) u_pa0 (.clk(clk), .rst(rst), .a(in_q_y), .b(in_v_z), .p(pa[0]));
-  ts_mul #(.A_W(Q_W), .B_W(V_W), .TARGET(TARGET)) u_pa1 (.clk(clk), .rst(rst), .a(in_q_z), .b(in_v_y), .p(pa[1]));
-  ts_mul #(.A_W(Q_W), .B_W(V_W), .TARGET(TARGET)) u_pa2 (.clk(clk), .rst(rst), .a(in_q_z), .b(in_v_x), .p(pa[2]));
-  ts_mul #(.A_W(Q_W), .B_W(V_W), .TARGET(TARGET)) u_pa3 (.clk(clk), .rst(rst), .a(in_q_x), .b(in_v_z), .p(pa[3]));
-  ts_mul #(.A_W(Q_W), .B_W(V_W), .TARGET(TARGET)) u_pa4 (.clk(clk), .rst(rst), .a(in_q_x), .b(in_v_y), .p(pa[4]));
-  ts_mul #(.A_W(Q_W), .B_W(V_W), .TARGET(TARGET)) u_pa5 (.clk(clk), .rst(rst), .a(in_q_y), .b(in_v_x), .p(pa[5]));
+  wire [6*PA_W-1:0] pa_bus;
+  ts_mul_bank #(.N(6), .FOLD(FOLD), .A_W(Q_W), .B_W(V_W), .TARGET(TARGET)) u_pa (
+    .clk(clk), .rst(rst), .in_valid(in_valid),
+    .in_a({in_q_y, in_q_x, in_q_x, in_q_z, in_q_z, in_q_y}),
+    .in_b({in_v_x, in_v_y, in_v_z, in_v_x, in_v_y, in_v_z}),
+    .out_p(pa_bus));
+  genvar i;
+  generate
+    for (i = 0; i < 6; i = i + 1) begin : g_pa
+      assign pa[i] = pa_bus[i*PA_W +: PA_W];
+    end
+  endgenerate
 
   reg signed [PA_W:0] da [0:2];
   integer k;
@@ -88,7 +98,6 @@ module ts_quat_rotate #(
   // 2 (q_v x v): the factor 2 moves the binary point (fraction Q_F + V_F - 1).
   wire signed [T_W-1:0] t [0:2];
   wire [2:0] sat_t;
-  genvar i;
   generate
     for (i = 0; i < 3; i = i + 1) begin : g_t
       ts_round_sat #(.IN_W(PA_W+1), .SHIFT(Q_F+V_F-1-T_F), .OUT_W(T_W), .SAT(1)) u_rs (
@@ -113,18 +122,25 @@ module ts_quat_rotate #(
   localparam PB_F = Q_F + T_F;
   wire signed [PB_W-1:0] wt [0:2];
   wire signed [PB_W-1:0] pb [0:5];
+  // stage B operands are valid (t out of its rounding) LA cycles after in_valid
+  wire b_valid;
+  ts_delay #(.W(1), .DEPTH(LA)) u_bv (.clk(clk), .rst(rst), .din(in_valid), .dout(b_valid));
+  // products 0-2: w t_i; 3-8: the cross terms, same order as stage A: (y b2, z b1), (z b0, x b2),
+  // (x b1, y b0)
+  wire [9*PB_W-1:0] pb_bus;
+  ts_mul_bank #(.N(9), .FOLD(FOLD), .A_W(Q_W), .B_W(T_W), .TARGET(TARGET)) u_pb (
+    .clk(clk), .rst(rst), .in_valid(b_valid),
+    .in_a({y_b, x_b, x_b, z_b, z_b, y_b, w_b, w_b, w_b}),
+    .in_b({t[0], t[1], t[2], t[0], t[1], t[2], t[2], t[1], t[0]}),
+    .out_p(pb_bus));
   generate
     for (i = 0; i < 3; i = i + 1) begin : g_wt
-      ts_mul #(.A_W(Q_W), .B_W(T_W), .TARGET(TARGET)) u_wt (.clk(clk), .rst(rst), .a(w_b), .b(t[i]), .p(wt[i]));
+      assign wt[i] = pb_bus[i*PB_W +: PB_W];
+    end
+    for (i = 0; i < 6; i = i + 1) begin : g_pb
+      assign pb[i] = pb_bus[(3+i)*PB_W +: PB_W];
     end
   endgenerate
-  // Cross-term products, same order as stage A: (y b2, z b1), (z b0, x b2), (x b1, y b0).
-  ts_mul #(.A_W(Q_W), .B_W(T_W), .TARGET(TARGET)) u_pb0 (.clk(clk), .rst(rst), .a(y_b), .b(t[2]), .p(pb[0]));
-  ts_mul #(.A_W(Q_W), .B_W(T_W), .TARGET(TARGET)) u_pb1 (.clk(clk), .rst(rst), .a(z_b), .b(t[1]), .p(pb[1]));
-  ts_mul #(.A_W(Q_W), .B_W(T_W), .TARGET(TARGET)) u_pb2 (.clk(clk), .rst(rst), .a(z_b), .b(t[0]), .p(pb[2]));
-  ts_mul #(.A_W(Q_W), .B_W(T_W), .TARGET(TARGET)) u_pb3 (.clk(clk), .rst(rst), .a(x_b), .b(t[2]), .p(pb[3]));
-  ts_mul #(.A_W(Q_W), .B_W(T_W), .TARGET(TARGET)) u_pb4 (.clk(clk), .rst(rst), .a(x_b), .b(t[1]), .p(pb[4]));
-  ts_mul #(.A_W(Q_W), .B_W(T_W), .TARGET(TARGET)) u_pb5 (.clk(clk), .rst(rst), .a(y_b), .b(t[0]), .p(pb[5]));
 
   // Exact sum format: fraction FS = max(V_F, PB_F); integer bits max + 2 (two additions).
   localparam FS = ts_max(V_F, PB_F);

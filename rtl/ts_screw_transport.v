@@ -7,7 +7,9 @@
 // The product s z is formed once and rounded to both jw_t and jv_t.  out_sat = 1 when the model
 // raises a saturation flag: the rotation, and for a revolute joint w, the lever arm or v (for a
 // prismatic joint v = s z); signals the model does not compute for the joint type never flag.
-// Latency: see LATENCY (docs/rtl/ts_screw_transport.md), II = 1.
+// Products on ts_mul_bank (FOLD products per multiplier: the rotation's 15, s z's 3 and the cross
+// product's 6).  Latency: see LATENCY (docs/rtl/ts_screw_transport.md), II = FOLD; the bits do
+// not depend on FOLD.
 // Language: Verilog 2005
 `resetall
 `timescale 1ns / 1ps
@@ -43,7 +45,9 @@ module ts_screw_transport #(
   // Jacobian v fraction bits
   parameter JV_F = 22,
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
-  parameter TARGET = "GENERIC"
+  parameter TARGET = "GENERIC",
+  // Products per multiplier (cycles per column, II); 1: 24 multipliers in parallel
+  parameter FOLD = 1
 ) (
   input  wire                   clk,
   input  wire                   rst,
@@ -79,9 +83,9 @@ module ts_screw_transport #(
   `include "ts_common.vh"
 
   localparam RL = ts_round_lat(1);
-  localparam LR = ts_mul_lat(Q_W, Q_W) + ts_mul_lat(Q_W, UT_W) + 3 + 2 * RL;   // ts_quat_rotate
-  localparam MLS = ts_mul_lat(S_W, Q_W);
-  localparam MLC = ts_mul_lat(JW_W, L_W);
+  localparam LR = ts_bank_lat(Q_W, Q_W, FOLD) + ts_bank_lat(Q_W, UT_W, FOLD) + 3 + 2 * RL;   // ts_quat_rotate
+  localparam MLS = ts_bank_lat(S_W, Q_W, FOLD);
+  localparam MLC = ts_bank_lat(JW_W, L_W, FOLD);
   // Cycle at which r, w (and the prismatic v) and the cross product are available; latency.
   localparam C_R = 1 + RL;
   localparam C_W = LR + MLS + RL;
@@ -95,7 +99,7 @@ module ts_screw_transport #(
   wire z_valid, z_sat;
   ts_quat_rotate #(
     .Q_W(Q_W), .Q_F(Q_F), .V_W(Q_W), .V_F(Q_F), .T_W(UT_W), .T_F(UT_F), .O_W(Q_W), .O_F(Q_F),
-    .INV(0), .TARGET(TARGET)
+    .INV(0), .TARGET(TARGET), .FOLD(FOLD)
   ) u_rot (
     .clk(clk), .rst(rst), .in_valid(in_valid),
     .in_q_w(in_q_w), .in_q_x(in_q_x), .in_q_y(in_q_y), .in_q_z(in_q_z),
@@ -129,11 +133,13 @@ module ts_screw_transport #(
   wire signed [JW_W-1:0] w [0:2];
   wire signed [JV_W-1:0] vp [0:2];
   wire [2:0] sat_w, sat_vp;
+  wire [3*(S_W+Q_W)-1:0] psz_bus;
+  ts_mul_bank #(.N(3), .FOLD(FOLD), .A_W(S_W), .B_W(Q_W), .TARGET(TARGET)) u_msz (
+    .clk(clk), .rst(rst), .in_valid(z_valid), .in_a({s_d, s_d, s_d}), .in_b({z[2], z[1], z[0]}),
+    .out_p(psz_bus));
   generate
     for (i = 0; i < 3; i = i + 1) begin : g_sz
-      wire signed [S_W+Q_W-1:0] psz;
-      ts_mul #(.A_W(S_W), .B_W(Q_W), .TARGET(TARGET)) u_m (
-        .clk(clk), .rst(rst), .a(s_d), .b(z[i]), .p(psz));
+      wire signed [S_W+Q_W-1:0] psz = psz_bus[i*(S_W+Q_W) +: S_W+Q_W];
       ts_round_sat #(.IN_W(S_W+Q_W), .SHIFT(S_F+Q_F-JW_F), .OUT_W(JW_W), .SAT(1)) u_rw (
         .clk(clk), .rst(rst), .in_x(psz), .out_y(w[i]), .out_sat(sat_w[i]));
       ts_round_sat #(.IN_W(S_W+Q_W), .SHIFT(S_F+Q_F-JV_F), .OUT_W(JV_W), .SAT(1)) u_rv (
@@ -144,13 +150,19 @@ module ts_screw_transport #(
   // ---- v = cross<jv_t>(w, r) ----------------------------------------------------------------------
   localparam PC_W = JW_W + L_W;
   wire signed [PC_W-1:0] pc [0:5];
-  // (w1 r2, w2 r1), (w2 r0, w0 r2), (w0 r1, w1 r0)
-  ts_mul #(.A_W(JW_W), .B_W(L_W), .TARGET(TARGET)) u_c0 (.clk(clk), .rst(rst), .a(w[1]), .b(r[2]), .p(pc[0]));
-  ts_mul #(.A_W(JW_W), .B_W(L_W), .TARGET(TARGET)) u_c1 (.clk(clk), .rst(rst), .a(w[2]), .b(r[1]), .p(pc[1]));
-  ts_mul #(.A_W(JW_W), .B_W(L_W), .TARGET(TARGET)) u_c2 (.clk(clk), .rst(rst), .a(w[2]), .b(r[0]), .p(pc[2]));
-  ts_mul #(.A_W(JW_W), .B_W(L_W), .TARGET(TARGET)) u_c3 (.clk(clk), .rst(rst), .a(w[0]), .b(r[2]), .p(pc[3]));
-  ts_mul #(.A_W(JW_W), .B_W(L_W), .TARGET(TARGET)) u_c4 (.clk(clk), .rst(rst), .a(w[0]), .b(r[1]), .p(pc[4]));
-  ts_mul #(.A_W(JW_W), .B_W(L_W), .TARGET(TARGET)) u_c5 (.clk(clk), .rst(rst), .a(w[1]), .b(r[0]), .p(pc[5]));
+  // (w1 r2, w2 r1), (w2 r0, w0 r2), (w0 r1, w1 r0); w (and r) are there C_W cycles after in_valid
+  wire w_valid;
+  ts_delay #(.W(1), .DEPTH(C_W)) u_wv (.clk(clk), .rst(rst), .din(in_valid), .dout(w_valid));
+  wire [6*PC_W-1:0] pc_bus;
+  ts_mul_bank #(.N(6), .FOLD(FOLD), .A_W(JW_W), .B_W(L_W), .TARGET(TARGET)) u_mc (
+    .clk(clk), .rst(rst), .in_valid(w_valid),
+    .in_a({w[1], w[0], w[0], w[2], w[2], w[1]}), .in_b({r[0], r[1], r[2], r[0], r[1], r[2]}),
+    .out_p(pc_bus));
+  generate
+    for (i = 0; i < 6; i = i + 1) begin : g_pc
+      assign pc[i] = pc_bus[i*PC_W +: PC_W];
+    end
+  endgenerate
   wire signed [JV_W-1:0] vc [0:2];
   wire [2:0] sat_vc;
   generate
@@ -210,7 +222,6 @@ module ts_screw_transport #(
     end
   end
 
-  wire unused_z_valid = z_valid;
   ts_delay #(.W(1), .DEPTH(LATENCY)) u_valid (.clk(clk), .rst(rst), .din(in_valid), .dout(out_valid));
 
 endmodule

@@ -23,7 +23,12 @@ module ts_servo_core #(
   parameter TARGET = "GENERIC",
   parameter TRIG_ROM = (CONFIG == 0) ? "ts_trig_rom_default.mem" : "ts_trig_rom_compact.mem",
   parameter RECIP_ROM = (CONFIG == 0) ? "ts_recip_rom_default.mem" : "ts_recip_rom_compact.mem",
-  parameter ROTVEC_ROM = (CONFIG == 0) ? "ts_rotvec_rom_default.mem" : "ts_rotvec_rom_compact.mem"
+  parameter ROTVEC_ROM = (CONFIG == 0) ? "ts_rotvec_rom_default.mem" : "ts_rotvec_rom_compact.mem",
+  // Products per multiplier in the FK and law engines' quaternion product, rotation and screw
+  // transport units (ts_mul_bank; 1: fully parallel).  The bits never depend on it; the cycle
+  // count of a tick does (docs/resources.md).  Up to 7 it costs no column throughput (the
+  // solver takes a column per 7 cycles).
+  parameter FOLD = 7
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -364,7 +369,7 @@ module ts_servo_core #(
   wire signed [JV_W-1:0] fc_vx, fc_vy, fc_vz;
   wire signed [P_W-1:0] fc_px, fc_py, fc_pz;
 
-  ts_core_fk #(.NMAX(NMAX), .CONFIG(CONFIG), .ROM_FILE(TRIG_ROM), .TARGET(TARGET)) u_fk (
+  ts_core_fk #(.NMAX(NMAX), .CONFIG(CONFIG), .ROM_FILE(TRIG_ROM), .TARGET(TARGET), .FOLD(FOLD)) u_fk (
     .clk(clk), .rst(rst),
     .in_cfg_we((st == S_LOAD) && fk_cv), .in_cfg_addr(ld), .in_cfg_data(fk_cd),
     .in_q_we(in_prep && !psub), .in_q_addr(pjj), .in_q_data(q_sel),
@@ -389,7 +394,7 @@ module ts_servo_core #(
   wire signed [JW_W-1:0] lc_wx, lc_wy, lc_wz;
   wire signed [JV_W-1:0] lc_vx, lc_vy, lc_vz;
 
-  ts_core_law #(.CONFIG(CONFIG), .ROM_FILE(ROTVEC_ROM), .TARGET(TARGET)) u_law (
+  ts_core_law #(.CONFIG(CONFIG), .ROM_FILE(ROTVEC_ROM), .TARGET(TARGET), .FOLD(FOLD)) u_law (
     .clk(clk), .rst(rst), .in_start(law_start), .in_mode_b(c_err_b), .in_err_only(c_err_only),
     .in_kp(c_kp), .in_ko(c_ko), .out_busy(law_busy), .out_done(law_done), .out_flags(law_flags),
     .in_tool_q_w(tq_w), .in_tool_q_x(tq_x), .in_tool_q_y(tq_y), .in_tool_q_z(tq_z),
@@ -413,7 +418,12 @@ module ts_servo_core #(
 
   // ---- columns and V into the solver --------------------------------------------------------------
   reg [JI_W:0] ci;                // next column to issue
-  reg [2:0] tm;                   // issue interval counter (one column every 7 cycles)
+  // one column every CI cycles: the solver's six-word write (7 cycles), or the law's column II
+  localparam integer CI = (FOLD > 7) ? FOLD : 7;
+  localparam integer TM_W = $clog2(CI);
+  localparam integer CI_M1 = CI - 1;
+  localparam [TM_W-1:0] TM_LAST = CI_M1[TM_W-1:0];
+  reg [TM_W-1:0] tm;              // issue interval counter
   reg [JI_W:0] wj;                // columns written into the solver
   reg [2:0] wc;                   // field being written (column or V)
   reg wr_act;                     // a column / V write burst is running
@@ -500,7 +510,7 @@ module ts_servo_core #(
       pj <= {(JI_W + 1){1'b0}}; psub <= 1'b0; cyc <= 32'd0; status_w <= 32'd0; ow <= {WI_W{1'b0}};
       tick_count <= 32'd0; tick_cycles <= 32'd0; flags_set <= 18'd0;
       c_start <= 1'b0; fk_start <= 1'b0; law_start <= 1'b0; sv_start <= 1'b0;
-      col_addr <= {JI_W{1'b0}}; col_v <= 1'b0; ci <= {(JI_W + 1){1'b0}}; tm <= 3'd0;
+      col_addr <= {JI_W{1'b0}}; col_v <= 1'b0; ci <= {(JI_W + 1){1'b0}}; tm <= {TM_W{1'b0}};
       wj <= {(JI_W + 1){1'b0}}; wc <= 3'd0; wr_act <= 1'b0; law_ok <= 1'b0; hold <= {(6 * CD_W){1'b0}};
       for (k = 0; k < 13; k = k + 1) sp[k] <= 32'd0;
     end else begin
@@ -559,18 +569,18 @@ module ts_servo_core #(
         end
         S_FK: begin
           if (fk_done) begin
-            law_start <= 1'b1; st <= S_LAW; ci <= {(JI_W + 1){1'b0}}; tm <= 3'd0;
+            law_start <= 1'b1; st <= S_LAW; ci <= {(JI_W + 1){1'b0}}; tm <= {TM_W{1'b0}};
             col_addr <= {JI_W{1'b0}}; wj <= {(JI_W + 1){1'b0}}; wr_act <= 1'b0; law_ok <= 1'b0;
           end
         end
         S_LAW: begin
           // column ci is at the FK read port (col_addr) in the cycle tm = 0
-          if (tm == 3'd6) tm <= 3'd0; else tm <= tm + 1'b1;
-          if ((tm == 3'd0) && (ci < n_c)) begin
+          if (tm == TM_LAST) tm <= {TM_W{1'b0}}; else tm <= tm + 1'b1;
+          if ((tm == {TM_W{1'b0}}) && (ci < n_c)) begin
             col_v <= 1'b1;
             ci <= ci + 1'b1;
           end
-          if (tm == 3'd1) col_addr <= ci[JI_W-1:0];
+          if (tm == {{(TM_W-1){1'b0}}, 1'b1}) col_addr <= ci[JI_W-1:0];
           if (law_done) law_ok <= 1'b1;
           if (lc_valid) begin
             hold <= {{{(CD_W + 1 - JV_W){lc_vz[JV_W-1]}}, lc_vz[JV_W-2:0]},

@@ -150,21 +150,28 @@ def screw_transport(cfg: str, target: str = "GENERIC") -> dict:
 
 
 # ---- latencies (documented; the benches check them) -------------------------------------------------
+def bank_lat(aw: int, bw: int, fold: int = 1) -> int:
+    """Latency of ts_mul_bank (rtl/ts_common.vh ts_bank_lat)."""
+    return mul_lat(aw, bw) + fold - 1
+
+
 def latency(module: str, p: dict) -> int:
+    """Latency of a datapath module for its parameters (FOLD, when given, as the module uses it)."""
     rl = ROUND_LAT
+    f = p.get("FOLD", 1)
     if module == "ts_quat_mul":
-        return mul_lat(p["Q_W"], p["Q_W"]) + 2 + rl
+        return bank_lat(p["Q_W"], p["Q_W"], f) + 2 + rl
     if module == "ts_quat_rotate":
-        return mul_lat(p["Q_W"], p["V_W"]) + mul_lat(p["Q_W"], p["T_W"]) + 3 + 2 * rl
+        return bank_lat(p["Q_W"], p["V_W"], f) + bank_lat(p["Q_W"], p["T_W"], f) + 3 + 2 * rl
     if module == "ts_sincos":
         return sincos_stages(p)["LATENCY"]
     if module == "ts_joint_quat":
         return (mul_lat(p["ANG_W"], p["KT_W"]) + rl + latency("ts_sincos", p)
                 + mul_lat(p["Q_W"], p["Q_W"]) + rl)
     if module == "ts_screw_transport":
-        lr = mul_lat(p["Q_W"], p["Q_W"]) + mul_lat(p["Q_W"], p["UT_W"]) + 3 + 2 * rl
-        cw = lr + mul_lat(p["S_W"], p["Q_W"]) + rl
-        return cw + mul_lat(p["JW_W"], p["L_W"]) + 1 + rl + 1
+        lr = bank_lat(p["Q_W"], p["Q_W"], f) + bank_lat(p["Q_W"], p["UT_W"], f) + 3 + 2 * rl
+        cw = lr + bank_lat(p["S_W"], p["Q_W"], f) + rl
+        return cw + bank_lat(p["JW_W"], p["L_W"], f) + 1 + rl + 1
     raise KeyError(module)
 
 
@@ -192,11 +199,12 @@ DEPS = {
     "ts_ecp5_mult18": [],
     "ts_sel": [],
     "ts_mul": ["ts_resize", "ts_delay", "ts_ecp5_mult18"],
-    "ts_quat_mul": ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
-    "ts_quat_rotate": ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
+    "ts_mul_bank": ["ts_mul", "ts_sel", "ts_delay"],
+    "ts_quat_mul": ["ts_mul_bank", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
+    "ts_quat_rotate": ["ts_mul_bank", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
     "ts_sincos": ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
     "ts_joint_quat": ["ts_sincos", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
-    "ts_screw_transport": ["ts_quat_rotate", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
+    "ts_screw_transport": ["ts_quat_rotate", "ts_mul_bank", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
 }
 DEPS["ts_core_fk"] = ["ts_joint_quat", "ts_sincos", "ts_quat_mul", "ts_quat_rotate", "ts_screw_transport", "ts_mul",
                       "ts_resize", "ts_delay", "ts_round_sat"]
@@ -313,6 +321,15 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
     for iw, l, ow in ((8, 0, 12), (8, 0, 8), (12, 0, 8), (8, 3, 14), (8, 3, 11), (8, 3, 9)):
         jobs.append(("ts_resize", sources("ts_resize"), {"IN_W": iw, "LSH": l, "OUT_W": ow}))
     jobs.append(("ts_ecp5_mult18", sources("ts_ecp5_mult18", "ECP5"), {}))
+    # the multiplier bank: parallel, folded with and without padding slots, one multiplier
+    for n, fold in ((6, 1), (16, 4), (9, 7), (6, 6), (3, 7)):
+        for target in TARGETS:
+            jobs.append(("ts_mul_bank", sources("ts_mul_bank", target),
+                         {"N": n, "FOLD": fold, "A_W": 18, "B_W": 27, "TARGET": target}))
+    # the folded primitives (the servo core's FOLD)
+    for cfg in CONFIGS:
+        for m in ("ts_quat_mul", "ts_quat_rotate", "ts_screw_transport"):
+            jobs.append((m, sources(m), dict(module_params(m, cfg), FOLD=7)))
     # the generated register block (rtl/ts_servo_regs.rdl): joint counts at the extremes, both configurations
     for nmax in (1, 8, 60):
         for config in (0, 1):
@@ -325,6 +342,9 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
         for nmax in (1, 64):
             jobs.append(("ts_core_fk", sources("ts_core_fk"),
                          {"NMAX": nmax, "CONFIG": config, "ROM_FILE": str(rom_file(CONFIGS[config])), "TARGET": "GENERIC"}))
+        jobs.append(("ts_core_fk", sources("ts_core_fk"),
+                     {"NMAX": 8, "CONFIG": config, "ROM_FILE": str(rom_file(CONFIGS[config])), "TARGET": "GENERIC",
+                      "FOLD": 7}))
     # the commit step (rtl/ts_core_commit.v): both configurations and multiplier targets, NMAX extremes
     for config in (0, 1):
         for target in TARGETS:
@@ -341,15 +361,19 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
     # the servo law (rtl/ts_core_law.v): both configurations and multiplier targets
     for config in (0, 1):
         for target in TARGETS:
-            jobs.append(("ts_core_law", sources("ts_core_law", target),
-                         {"CONFIG": config, "TARGET": target,
-                          "ROM_FILE": str(RTL / f"ts_rotvec_rom_{CONFIGS[config]}.mem")}))
+            for fold in (1, 7):
+                jobs.append(("ts_core_law", sources("ts_core_law", target),
+                             {"CONFIG": config, "TARGET": target, "FOLD": fold,
+                              "ROM_FILE": str(RTL / f"ts_rotvec_rom_{CONFIGS[config]}.mem")}))
     # the servo core top (rtl/ts_servo_core.v): both configurations and targets, NMAX 8 and 20
     # (rtl/ts_common.vh waives one spurious Verilator 5.006 VARHIDDEN of the GENERIC elaboration)
     for config in (0, 1):
         for target in TARGETS:
             for nmax in (8, 20):
                 jobs.append(("ts_servo_core", sources("ts_servo_core", target), servo_core(CONFIGS[config], target, nmax)))
+        # fully parallel (FOLD 1) and a fold above the column interval
+        for fold in (1, 9):
+            jobs.append(("ts_servo_core", sources("ts_servo_core"), dict(servo_core(CONFIGS[config], "GENERIC", 8), FOLD=fold)))
     return jobs
 
 

@@ -163,12 +163,13 @@ def to_signed(u: int, w: int) -> int:
 
 
 class Stream:
-    """Drives named input ports one vector per cycle (with random valid gaps) and collects the named
+    """Drives named input ports one vector per ``ii`` cycles at most (with random valid gaps) and collects the named
     output ports on ``out_valid``; checks that every vector comes out exactly ``latency`` cycles after
     it went in and that no output is X/Z from reset on."""
 
     def __init__(self, dut, inputs: list[str], outputs: list[str], latency: int, rng,
-                 p_valid: float = 0.75, clk: str = "clk", rst: str = "rst", unsigned: tuple = ()):
+                 p_valid: float = 0.75, clk: str = "clk", rst: str = "rst", unsigned: tuple = (),
+                 ii: int = 1):
         self.dut = dut
         self.clk = getattr(dut, clk)
         self.rst = getattr(dut, rst)
@@ -183,6 +184,7 @@ class Stream:
         self.latency = latency
         self.rng = rng
         self.p_valid = p_valid
+        self.ii = ii          # initiation interval: cycles from one input vector to the next, at least
 
     async def reset(self, cycles: int = 4) -> None:
         import cocotb
@@ -229,7 +231,7 @@ class Stream:
                 idle += 1
                 if idle > self.latency + 8 and k >= n:
                     raise AssertionError(f"only {len(got)} of {n} vectors came out")
-            if k < n and valid_draw[cyc % len(valid_draw)]:
+            if k < n and valid_draw[cyc % len(valid_draw)] and (not in_cycle or cyc - in_cycle[-1] >= self.ii):
                 self.in_valid.value = 1
                 for h, m, v in zip(self.ins, self.in_masks, rows[k]):
                     h.value = int(v) & m

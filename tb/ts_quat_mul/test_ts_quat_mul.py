@@ -36,7 +36,8 @@ if cocotb is not None:
         exp = gp.expected("quat_mul", cfg, ins)
         rows = [tuple(r) for r in np.concatenate([ins["a"], ins["b"]], axis=1).tolist()]
         st = tsbench.Stream(dut, ["in_a_w", "in_a_x", "in_a_y", "in_a_z", "in_b_w", "in_b_x", "in_b_y", "in_b_z"],
-                            ["out_w", "out_x", "out_y", "out_z", "out_sat"], rtlparams.latency(MODULE, p), rng)
+                            ["out_w", "out_x", "out_y", "out_z", "out_sat"], rtlparams.latency(MODULE, p), rng,
+                            ii=p.get("FOLD", 1))
         await st.reset()
         got = np.array(await st.run(rows), dtype=np.int64)
         out, sat = got[:, :4], got[:, 4]
@@ -70,3 +71,14 @@ def test_ts_quat_mul(cfg, sim):
     tsbench.run_bench(toplevel=MODULE, test_file=__file__, sources=rtlparams.sources(MODULE, target),
                       parameters=p, sim=sim, build_name=f"{cfg}-{target}-{sim}",
                       env={"TS_CONFIG": cfg, "TS_PARAMS": json.dumps(p)})
+
+
+@pytest.mark.parametrize("fold", (5,))
+@pytest.mark.parametrize("cfg", tsbench.CONFIGS)
+def test_ts_quat_mul_folded(cfg, fold):
+    """The folded form (16 / FOLD multipliers, II = FOLD): the same bits, the documented latency."""
+    target = tsbench.target_for("verilator")
+    p = dict(rtlparams.quat_mul(cfg, target), FOLD=fold)
+    tsbench.run_bench(toplevel=MODULE, test_file=__file__, sources=rtlparams.sources(MODULE, target),
+                      parameters=p, sim="verilator", build_name=f"{cfg}-{target}-fold{fold}",
+                      env={"TS_CONFIG": cfg, "TS_PARAMS": json.dumps(p), "TS_NVEC": "2000"})

@@ -64,7 +64,9 @@ module tb_ts_quat_rotate #(
   // kind jv: output fraction bits
   parameter JV_O_F = 22,
   // multiplier implementation
-  parameter TARGET = "GENERIC"
+  parameter TARGET = "GENERIC",
+  // products per multiplier (II)
+  parameter FOLD = 1
 ) (
   input  wire           clk,
   input  wire           rst,
@@ -89,7 +91,7 @@ module tb_ts_quat_rotate #(
       wire signed [O_W-1:0] ox, oy, oz;
       ts_quat_rotate #(
         .Q_W(Q_W), .Q_F(Q_F), .V_W(V_W), .V_F(V_F), .T_W(T_W), .T_F(T_F), .O_W(O_W), .O_F(O_F),
-        .INV(m % 2), .TARGET(TARGET)
+        .INV(m % 2), .TARGET(TARGET), .FOLD(FOLD)
       ) u_rot (
         .clk(clk), .rst(rst), .in_valid(in_valid),
         .in_q_w(in_bus[0*32 +: Q_W]), .in_q_x(in_bus[1*32 +: Q_W]),

@@ -61,7 +61,8 @@ if cocotb is not None:
             for s, x in enumerate(r):
                 word |= (x & m32) << (SLOT * s)
             rows.append((word,))
-        st = tsbench.Stream(dut, ["in_bus"], ["out_bus"], rtlparams.latency(MODULE, pk["axis"]), rng)
+        st = tsbench.Stream(dut, ["in_bus"], ["out_bus"], rtlparams.latency(MODULE, pk["axis"]), rng,
+                            ii=pk["axis"].get("FOLD", 1))
         await st.reset()
         got = await st.run(rows)
         busw = 24 * SLOT + 16
@@ -108,14 +109,25 @@ if cocotb is not None:
 @pytest.mark.parametrize("sim", tsbench.SIMS)
 @pytest.mark.parametrize("cfg", tsbench.CONFIGS)
 def test_ts_quat_rotate(cfg, sim):
+    run_rotate(cfg, sim, 1)
+
+
+@pytest.mark.parametrize("fold", (4,))
+@pytest.mark.parametrize("cfg", tsbench.CONFIGS)
+def test_ts_quat_rotate_folded(cfg, fold):
+    """The folded form (FOLD products per multiplier, II = FOLD): the same bits, the documented latency."""
+    run_rotate(cfg, "verilator", fold, nvec=2000)
+
+
+def run_rotate(cfg, sim, fold, nvec=None):
     target = tsbench.target_for(sim)
-    pk = {k: rtlparams.quat_rotate(cfg, k, False, target) for k in KINDS}
-    params = {"Q_W": pk["axis"]["Q_W"], "Q_F": pk["axis"]["Q_F"], "TARGET": target}
+    pk = {k: dict(rtlparams.quat_rotate(cfg, k, False, target), FOLD=fold) for k in KINDS}
+    params = {"Q_W": pk["axis"]["Q_W"], "Q_F": pk["axis"]["Q_F"], "TARGET": target, "FOLD": fold}
     for k, pre in zip(KINDS, ("AX", "OF", "JW", "JV")):
         for key in ("V_W", "V_F", "T_W", "T_F", "O_W", "O_F"):
             params[f"{pre}_{key}"] = pk[k][key]
     here = os.path.dirname(os.path.abspath(__file__))
     tsbench.run_bench(toplevel="tb_ts_quat_rotate", test_file=__file__,
                       sources=[os.path.join(here, "tb_ts_quat_rotate.v")] + rtlparams.sources(MODULE, target),
-                      parameters=params, sim=sim, build_name=f"{cfg}-{target}-{sim}",
-                      env={"TS_CONFIG": cfg, "TS_PARAMS": json.dumps(pk)})
+                      parameters=params, sim=sim, build_name=f"{cfg}-{target}-{sim}" + (f"-fold{fold}" if fold > 1 else ""),
+                      env=dict({"TS_CONFIG": cfg, "TS_PARAMS": json.dumps(pk)}, **({"TS_NVEC": str(nvec)} if nvec else {})))

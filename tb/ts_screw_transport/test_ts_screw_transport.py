@@ -70,7 +70,7 @@ if cocotb is not None:
         names = (["in_q_w", "in_q_x", "in_q_y", "in_q_z", "in_axis_x", "in_axis_y", "in_axis_z", "in_prismatic",
                   "in_s", "in_pref_x", "in_pref_y", "in_pref_z", "in_pi_x", "in_pi_y", "in_pi_z"])
         outs = [f"out_{g}_{c}" for g in "zwv" for c in "xyz"] + ["out_sat"]
-        st = tsbench.Stream(dut, names, outs, rtlparams.latency(MODULE, p), rng)
+        st = tsbench.Stream(dut, names, outs, rtlparams.latency(MODULE, p), rng, ii=p.get("FOLD", 1))
         await st.reset()
         got = np.array(await st.run([tuple(r) for r in cols.tolist()]), dtype=np.int64)
         res = {"z": got[:, 0:3], "w": got[:, 3:6], "v": got[:, 6:9]}
@@ -108,3 +108,14 @@ def test_ts_screw_transport(cfg, sim):
     tsbench.run_bench(toplevel=MODULE, test_file=__file__, sources=rtlparams.sources(MODULE, target),
                       parameters=p, sim=sim, build_name=f"{cfg}-{target}-{sim}",
                       env={"TS_CONFIG": cfg, "TS_PARAMS": json.dumps(p)})
+
+
+@pytest.mark.parametrize("fold", (3,))
+@pytest.mark.parametrize("cfg", tsbench.CONFIGS)
+def test_ts_screw_transport_folded(cfg, fold):
+    """The folded form (FOLD products per multiplier, II = FOLD): the same bits, the documented latency."""
+    target = tsbench.target_for("verilator")
+    p = dict(rtlparams.screw_transport(cfg, target), FOLD=fold)
+    tsbench.run_bench(toplevel=MODULE, test_file=__file__, sources=rtlparams.sources(MODULE, target),
+                      parameters=p, sim="verilator", build_name=f"{cfg}-{target}-fold{fold}",
+                      env={"TS_CONFIG": cfg, "TS_PARAMS": json.dumps(p), "TS_NVEC": "2000"})

@@ -1,0 +1,145 @@
+// SPDX-License-Identifier: Apache-2.0
+// tensor-servo: a bank of N exact signed products p_k = a_k * b_k (A_W + B_W bits each), computed
+// on L = ceil(N / FOLD) registered multipliers (ts_mul) over FOLD cycles.
+//   FOLD = 1: N multipliers in parallel, latency ts_mul_lat(A_W, B_W), II = 1 (in_valid unused).
+//   FOLD > 1: the operands are taken at in_valid (cycle 0) and held; in cycle c (0 <= c < FOLD)
+//             multiplier l forms product c L + l; the products of the earlier phases are held in
+//             registers until the last phase's come out, so every out_p slot is valid in the one
+//             cycle ts_bank_lat(A_W, B_W, FOLD) = ts_mul_lat(A_W, B_W) + FOLD - 1 after in_valid.
+//             II = FOLD: in_valid must not be set again within FOLD - 1 cycles of the last one.
+// The products are exact, so a unit built on the bank gives the same bits at every FOLD; only
+// its latency, its initiation interval and its multiplier count change (docs/rtl/shared.md).
+// Language: Verilog 2005
+`resetall
+`timescale 1ns / 1ps
+`default_nettype none
+
+module ts_mul_bank #(
+  // Number of products
+  parameter N = 4,
+  // Products per multiplier (cycles per operation), >= 1
+  parameter FOLD = 1,
+  // Width of the a operands (signed)
+  parameter A_W = 18,
+  // Width of the b operands (signed)
+  parameter B_W = 18,
+  // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
+  parameter TARGET = "GENERIC"
+) (
+  input  wire                       clk,
+  input  wire                       rst,
+  input  wire                       in_valid,
+  // operand k: in_a[k*A_W +: A_W], in_b[k*B_W +: B_W]
+  input  wire [N*A_W-1:0]           in_a,
+  input  wire [N*B_W-1:0]           in_b,
+  // product k: out_p[k*(A_W+B_W) +: A_W+B_W]
+  output wire [N*(A_W+B_W)-1:0]     out_p
+);
+
+  `include "ts_common.vh"
+
+  localparam P_W = A_W + B_W;
+
+  genvar l, c;
+  generate
+    if (FOLD < 1) begin : g_bad
+      // Elaboration error: FOLD must be at least 1.
+      ts_mul_bank_fold_must_be_positive u_error ();
+    end
+
+    if (FOLD == 1) begin : g_par
+      for (l = 0; l < N; l = l + 1) begin : g_m
+        ts_mul #(.A_W(A_W), .B_W(B_W), .TARGET(TARGET)) u_m (
+          .clk(clk), .rst(rst), .a(in_a[l*A_W +: A_W]), .b(in_b[l*B_W +: B_W]), .p(out_p[l*P_W +: P_W]));
+      end
+      wire unused_valid = in_valid;
+    end else begin : g_fold
+      localparam L = (N + FOLD - 1) / FOLD;       // multipliers
+      localparam NP = L * FOLD;                   // slots, padded
+      localparam PH_W = $clog2(FOLD);
+      localparam ML = ts_mul_lat(A_W, B_W);
+      localparam integer FOLD_M1 = FOLD - 1;
+      localparam [PH_W-1:0] LAST = FOLD_M1[PH_W-1:0];
+
+      // operands padded to NP slots (the padding slots multiply zeros and are never read)
+      wire [NP*A_W-1:0] pa;
+      wire [NP*B_W-1:0] pb;
+      if (NP > N) begin : g_pad
+        assign pa = {{((NP-N)*A_W){1'b0}}, in_a};
+        assign pb = {{((NP-N)*B_W){1'b0}}, in_b};
+      end else begin : g_nopad
+        assign pa = in_a;
+        assign pb = in_b;
+      end
+      // held operands of phases 1 .. FOLD-1 (slot s at [(s-L)*W])
+      reg  [(NP-L)*A_W-1:0] ha;
+      reg  [(NP-L)*B_W-1:0] hb;
+      reg  [PH_W-1:0]   ph;                       // phase of this cycle's operands when not 0
+      always @(posedge clk) begin
+        if (rst) begin
+          ha <= {((NP-L)*A_W){1'b0}};
+          hb <= {((NP-L)*B_W){1'b0}};
+          ph <= {PH_W{1'b0}};
+        end else if (in_valid) begin
+          ha <= pa[NP*A_W-1:L*A_W];
+          hb <= pb[NP*B_W-1:L*B_W];
+          ph <= {{(PH_W-1){1'b0}}, 1'b1};
+        end else if (ph != {PH_W{1'b0}}) begin
+          ph <= (ph == LAST) ? {PH_W{1'b0}} : ph + 1'b1;
+        end
+      end
+      wire [PH_W-1:0] sel = in_valid ? {PH_W{1'b0}} : ph;
+      wire            act = in_valid | (ph != {PH_W{1'b0}});
+
+      // phase of the products at the multiplier outputs
+      wire [PH_W:0] osel;
+      ts_delay #(.W(PH_W+1), .DEPTH(ML)) u_od (.clk(clk), .rst(rst), .din({act, sel}), .dout(osel));
+      wire            o_act = osel[PH_W];
+      wire [PH_W-1:0] o_ph = osel[PH_W-1:0];
+
+      for (l = 0; l < L; l = l + 1) begin : g_lane
+        // candidates of this lane, one per phase: phase 0 from the inputs, the others held
+        wire [FOLD*A_W-1:0] ca;
+        wire [FOLD*B_W-1:0] cb;
+        for (c = 0; c < FOLD; c = c + 1) begin : g_c
+          if (c == 0) begin : g_in
+            assign ca[c*A_W +: A_W] = pa[(c*L+l)*A_W +: A_W];
+            assign cb[c*B_W +: B_W] = pb[(c*L+l)*B_W +: B_W];
+          end else begin : g_held
+            assign ca[c*A_W +: A_W] = ha[((c-1)*L+l)*A_W +: A_W];
+            assign cb[c*B_W +: B_W] = hb[((c-1)*L+l)*B_W +: B_W];
+          end
+        end
+        wire [A_W-1:0] a_l;
+        wire [B_W-1:0] b_l;
+        ts_sel #(.W(A_W), .N(FOLD), .IW(PH_W)) u_sa (.in_vec(ca), .in_idx(sel), .out_el(a_l));
+        ts_sel #(.W(B_W), .N(FOLD), .IW(PH_W)) u_sb (.in_vec(cb), .in_idx(sel), .out_el(b_l));
+        wire signed [P_W-1:0] p_l;
+        ts_mul #(.A_W(A_W), .B_W(B_W), .TARGET(TARGET)) u_m (
+          .clk(clk), .rst(rst), .a(a_l), .b(b_l), .p(p_l));
+
+        // products of the phases before the last are held; the last phase's pass through
+        for (c = 0; c < FOLD; c = c + 1) begin : g_o
+          if (c*L + l < N) begin : g_used
+            if (c == FOLD - 1) begin : g_last
+              assign out_p[(c*L+l)*P_W +: P_W] = p_l;
+            end else begin : g_held
+              localparam [PH_W-1:0] C = c;
+              reg [P_W-1:0] cap;
+              always @(posedge clk) begin
+                if (rst) cap <= {P_W{1'b0}};
+                else if (o_act && (o_ph == C)) cap <= p_l;
+              end
+              assign out_p[(c*L+l)*P_W +: P_W] = cap;
+            end
+          end else if (c == FOLD - 1) begin : g_pad
+            wire unused_p = ^p_l;
+          end
+        end
+      end
+    end
+  endgenerate
+
+endmodule
+
+`default_nettype wire
