@@ -396,7 +396,7 @@ module ts_core_fk #(
     .out_v_x(st_v[0]), .out_v_y(st_v[1]), .out_v_z(st_v[2]), .out_sat(st_sat));
 
   // ---- prismatic origin p_i = cvt<pos_t>(pF + d z) ----------------------------------------------------
-  localparam MLP = ts_mul_lat(L_W, Q_W);
+  localparam MLP = ts_bank_lat(L_W, Q_W, FOLD);
   localparam PP_F = ts_max(L_F + Q_F, P_F);
   localparam PP_W = ts_max(L_W + Q_W - L_F - Q_F, P_W - P_F) + 1 + PP_F;
   reg pp_valid;
@@ -404,11 +404,13 @@ module ts_core_fk #(
   wire [2:0] pp_sat;
   wire signed [P_W-1:0] pp_o [0:2];
   ts_delay #(.W(1), .DEPTH(MLP+1+RL)) u_ppv (.clk(clk), .rst(rst), .din(pp_valid), .dout(pp_ovalid));
+  wire [3*(L_W+Q_W)-1:0] pp_p;
+  ts_mul_bank #(.N(3), .FOLD(FOLD), .A_W(L_W), .B_W(Q_W), .TARGET(TARGET)) u_mpp (
+    .clk(clk), .rst(rst), .in_valid(pp_valid), .in_a({r_d[ji], r_d[ji], r_d[ji]}), .in_b({zr[2], zr[1], zr[0]}),
+    .out_p(pp_p));
   generate
     for (gi = 0; gi < 3; gi = gi + 1) begin : g_pp
-      wire signed [L_W+Q_W-1:0] prod;
-      ts_mul #(.A_W(L_W), .B_W(Q_W), .TARGET(TARGET)) u_m (
-        .clk(clk), .rst(rst), .a(r_d[ji]), .b(zr[gi]), .p(prod));
+      wire signed [L_W+Q_W-1:0] prod = pp_p[gi*(L_W+Q_W) +: L_W+Q_W];
       // pF waits for the product (it does not change while the product is formed)
       wire signed [PP_W-1:0] pa, pb;
       ts_resize #(.IN_W(L_W+Q_W), .LSH(PP_F-L_F-Q_F), .OUT_W(PP_W)) u_pa (.in(prod), .out(pa));

@@ -158,7 +158,8 @@ module ts_core_law #(
   localparam IX_W = Q_W - 1 - FB;
 
   generate
-    if ((FB < 1) || (IX_W < TB + 1) || (Q_F + TS_LEN_TMP_F < PE_F) || (Q_F + TS_JV_TMP_F < V_F)) begin : g_bad
+    if ((FB < 1) || (IX_W < TB + 1) || (Q_F + TS_LEN_TMP_F < PE_F) || (Q_F + TS_JV_TMP_F < V_F) ||
+        (RO_W != PE_W)) begin : g_bad
       // Elaboration error: a width parameter was overridden inconsistently with CONFIG.
       ts_core_law_inconsistent_width_parameters u_error ();
     end
@@ -215,7 +216,6 @@ module ts_core_law #(
   // rotation reads held registers, so its output stays valid from its latency on.
   reg s0;   // the registered inputs are valid
   reg b0;   // conj(Q_P) and dp latched
-  reg b1;
   reg c0;   // the error quaternion latched
   reg c1;   // the sign-corrected error quaternion latched
   reg c2;   // f latched
@@ -325,13 +325,15 @@ module ts_core_law #(
   reg signed [RV_W-1:0] fr;
 
   // eo_a = cvt<rot_t>(2 f q_a)
-  localparam MLE = ts_mul_lat(RV_W, Q_W);
+  localparam MLE = ts_bank_lat(RV_W, Q_W, FOLD);
   wire signed [RO_W-1:0] eo_o [0:2];
   wire [2:0] eo_sat;
+  wire [3*(RV_W+Q_W)-1:0] eo_p;
+  ts_mul_bank #(.N(3), .FOLD(FOLD), .A_W(RV_W), .B_W(Q_W), .TARGET(TARGET)) u_meo (
+    .clk(clk), .rst(rst), .in_valid(c2), .in_a({fr, fr, fr}), .in_b({qn[3], qn[2], qn[1]}), .out_p(eo_p));
   generate
     for (gi = 0; gi < 3; gi = gi + 1) begin : g_eo
-      wire signed [RV_W+Q_W-1:0] prod;
-      ts_mul #(.A_W(RV_W), .B_W(Q_W), .TARGET(TARGET)) u_m (.clk(clk), .rst(rst), .a(fr), .b(qn[gi+1]), .p(prod));
+      wire signed [RV_W+Q_W-1:0] prod = eo_p[gi*(RV_W+Q_W) +: RV_W+Q_W];
       ts_round_sat #(.IN_W(RV_W+Q_W), .SHIFT(RV_F+Q_F-1-RO_F), .OUT_W(RO_W), .SAT(1)) u_rs (
         .clk(clk), .rst(rst), .in_x(prod), .out_y(eo_o[gi]), .out_sat(eo_sat[gi]));
     end
@@ -341,18 +343,20 @@ module ts_core_law #(
   reg signed [RO_W-1:0] eo [0:2];
 
   // ---- mode B feed-forward lever: vP = cvt<vel_t>(v_U + cross<vel_t>(dp, w_U)) ---------------------
-  localparam MLX = ts_mul_lat(PE_W, V_W);
+  localparam MLX = ts_bank_lat(PE_W, V_W, FOLD);
   localparam X_W = PE_W + V_W;
   wire signed [V_W-1:0] lev_o [0:2];
   wire [2:0] lev_sat;
+  // products 2 c and 2 c + 1 of component c: dp[j] w[k] and dp[k] w[j], (j, k) = (c+1, c+2) mod 3
+  wire [6*X_W-1:0] lev_p;
+  ts_mul_bank #(.N(6), .FOLD(FOLD), .A_W(PE_W), .B_W(V_W), .TARGET(TARGET)) u_mlev (
+    .clk(clk), .rst(rst), .in_valid(b0),
+    .in_a({dp[1], dp[0], dp[0], dp[2], dp[2], dp[1]}), .in_b({uw[0], uw[1], uw[2], uw[0], uw[1], uw[2]}),
+    .out_p(lev_p));
   generate
     for (gi = 0; gi < 3; gi = gi + 1) begin : g_lev
-      // component gi: dp[j] w[k] - dp[k] w[j], (j, k) = (gi+1, gi+2) mod 3
-      localparam J = (gi + 1) % 3;
-      localparam K = (gi + 2) % 3;
-      wire signed [X_W-1:0] pa, pb;
-      ts_mul #(.A_W(PE_W), .B_W(V_W), .TARGET(TARGET)) u_ma (.clk(clk), .rst(rst), .a(dp[J]), .b(uw[K]), .p(pa));
-      ts_mul #(.A_W(PE_W), .B_W(V_W), .TARGET(TARGET)) u_mb (.clk(clk), .rst(rst), .a(dp[K]), .b(uw[J]), .p(pb));
+      wire signed [X_W-1:0] pa = lev_p[(2*gi)*X_W +: X_W];
+      wire signed [X_W-1:0] pb = lev_p[(2*gi+1)*X_W +: X_W];
       reg signed [X_W:0] d;
       always @(posedge clk) begin
         if (rst) d <= {(X_W+1){1'b0}};
@@ -379,7 +383,7 @@ module ts_core_law #(
 
   // ---- mode B: the rotation by conj(Q_P) of dp (kind perr: perr_t, len_tmp_t, perr_t) and of w_U
   // and vP (kind vel: vel_t, jv_tmp_t, vel_t).  The model's two-stage rotate<Out, Tmp, true>
-  // (quat.hpp) on ts_mul / ts_round_sat, one vector per cycle, with a rounding pair per kind: the
+  // (quat.hpp) on ts_mul_bank / ts_round_sat, one vector per FOLD cycles, with a rounding pair per kind: the
   // two stages' saturations raise different status bits (tmp: ovf_pos for perr, ovf_jac for vel;
   // out: ovf_servo), which ts_quat_rotate's single out_sat cannot tell apart.
   localparam VI_W = ts_max(PE_W, V_W);
@@ -387,8 +391,8 @@ module ts_core_law #(
   localparam VF1 = V_F, TF1 = TS_JV_TMP_F, TW1 = TS_JV_TMP_W;
   localparam TT_W = ts_max(TW0, TW1);
   localparam OO_W = ts_max(PE_W, V_W);
-  localparam MRA = ts_mul_lat(Q_W, VI_W);
-  localparam MRB = ts_mul_lat(Q_W, TT_W);
+  localparam MRA = ts_bank_lat(Q_W, VI_W, FOLD);
+  localparam MRB = ts_bank_lat(Q_W, TT_W, FOLD);
   localparam RLA = MRA + 1 + RL;                 // t available
   localparam ROT_LAT = RLA + MRB + 2 + RL;
   localparam RA_W = Q_W + VI_W;
@@ -397,13 +401,37 @@ module ts_core_law #(
   localparam LS1 = Q_F + TF1 - VF1;
   localparam SB_W = ts_max(VI_W + ts_max(LS0, LS1), RB_W) + 2;
 
-  // issue: dp at b0, w_U at b1 (B with feed-forward), vP when it is there
-  wire rot_go_ep = b0 && r_mb;
-  wire rot_go_w = b1 && r_mb && r_ff;
-  wire rot_go_v = p_vp_raw && r_mb && r_ff;
+  // requests: dp and w_U (B with feed-forward) at b0, vP when it is there; each waits until the
+  // rotation's banks can take it (one vector per FOLD cycles), dp first, then w_U, then vP
+  localparam GAP_W = (FOLD > 1) ? $clog2(FOLD) : 1;
+  localparam integer FOLD_M1 = FOLD - 1;
+  localparam [GAP_W-1:0] GAP_MAX = FOLD_M1[GAP_W-1:0];
+  reg pend_ep, pend_w, pend_v;
+  reg [GAP_W-1:0] rgap;
+  wire want_ep = pend_ep || (b0 && r_mb);
+  wire want_w = pend_w || (b0 && r_mb && r_ff);
+  wire want_v = pend_v || (p_vp_raw && r_mb && r_ff);
+  wire rot_can = (rgap == {GAP_W{1'b0}});
+  wire rot_go_ep = rot_can && want_ep;
+  wire rot_go_w = rot_can && !want_ep && want_w;
+  wire rot_go_v = rot_can && !want_ep && !want_w && want_v;
   wire rot_valid = rot_go_ep || rot_go_w || rot_go_v;
   wire rot_kind = !rot_go_ep;                    // 0: perr, 1: vel
   wire [1:0] rot_tag = rot_go_ep ? 2'd0 : (rot_go_w ? 2'd1 : 2'd2);
+  always @(posedge clk) begin
+    if (rst) begin
+      pend_ep <= 1'b0;
+      pend_w <= 1'b0;
+      pend_v <= 1'b0;
+      rgap <= {GAP_W{1'b0}};
+    end else begin
+      pend_ep <= want_ep && !rot_go_ep;
+      pend_w <= want_w && !rot_go_w;
+      pend_v <= want_v && !rot_go_v;
+      if (rot_valid) rgap <= GAP_MAX;
+      else if (!rot_can) rgap <= rgap - 1'b1;
+    end
+  end
   wire signed [VI_W-1:0] rv [0:2];
   generate
     for (gi = 0; gi < 3; gi = gi + 1) begin : g_rv
@@ -416,12 +444,16 @@ module ts_core_law #(
   endgenerate
   // stage A: t = 2 (q_v x v) with q_v negated (INV): products (y a2, z a1), (z a0, x a2), (x a1, y a0)
   wire signed [RA_W-1:0] ra [0:5];
-  ts_mul #(.A_W(Q_W), .B_W(VI_W), .TARGET(TARGET)) u_ra0 (.clk(clk), .rst(rst), .a(tq[2]), .b(rv[2]), .p(ra[0]));
-  ts_mul #(.A_W(Q_W), .B_W(VI_W), .TARGET(TARGET)) u_ra1 (.clk(clk), .rst(rst), .a(tq[3]), .b(rv[1]), .p(ra[1]));
-  ts_mul #(.A_W(Q_W), .B_W(VI_W), .TARGET(TARGET)) u_ra2 (.clk(clk), .rst(rst), .a(tq[3]), .b(rv[0]), .p(ra[2]));
-  ts_mul #(.A_W(Q_W), .B_W(VI_W), .TARGET(TARGET)) u_ra3 (.clk(clk), .rst(rst), .a(tq[1]), .b(rv[2]), .p(ra[3]));
-  ts_mul #(.A_W(Q_W), .B_W(VI_W), .TARGET(TARGET)) u_ra4 (.clk(clk), .rst(rst), .a(tq[1]), .b(rv[1]), .p(ra[4]));
-  ts_mul #(.A_W(Q_W), .B_W(VI_W), .TARGET(TARGET)) u_ra5 (.clk(clk), .rst(rst), .a(tq[2]), .b(rv[0]), .p(ra[5]));
+  wire [6*RA_W-1:0] ra_p;
+  ts_mul_bank #(.N(6), .FOLD(FOLD), .A_W(Q_W), .B_W(VI_W), .TARGET(TARGET)) u_mra (
+    .clk(clk), .rst(rst), .in_valid(rot_valid),
+    .in_a({tq[2], tq[1], tq[1], tq[3], tq[3], tq[2]}), .in_b({rv[0], rv[1], rv[2], rv[0], rv[1], rv[2]}),
+    .out_p(ra_p));
+  generate
+    for (gi = 0; gi < 6; gi = gi + 1) begin : g_ra
+      assign ra[gi] = ra_p[gi*RA_W +: RA_W];
+    end
+  endgenerate
   wire kind_a;     // kind at the t rounding output
   ts_delay #(.W(1), .DEPTH(RLA)) u_ka (.clk(clk), .rst(rst), .din(rot_kind), .dout(kind_a));
   wire signed [TT_W-1:0] rt [0:2];
@@ -451,17 +483,23 @@ module ts_core_law #(
   //   r0 = a0 + w b0 + (z b1 - y b2), r1 = a1 + w b1 + (x b2 - z b0), r2 = a2 + w b2 + (y b0 - x b1)
   wire signed [RB_W-1:0] rw [0:2];
   wire signed [RB_W-1:0] rc [0:5];
+  // products 0-2: w t_i; 3-8: (z b1, y b2), (x b2, z b0), (y b0, x b1)
+  wire rb_valid;
+  ts_delay #(.W(1), .DEPTH(RLA)) u_rbv (.clk(clk), .rst(rst), .din(rot_valid), .dout(rb_valid));
+  wire [9*RB_W-1:0] rb_p;
+  ts_mul_bank #(.N(9), .FOLD(FOLD), .A_W(Q_W), .B_W(TT_W), .TARGET(TARGET)) u_mrb (
+    .clk(clk), .rst(rst), .in_valid(rb_valid),
+    .in_a({tq[1], tq[2], tq[3], tq[1], tq[2], tq[3], tq[0], tq[0], tq[0]}),
+    .in_b({rt[1], rt[0], rt[0], rt[2], rt[2], rt[1], rt[2], rt[1], rt[0]}),
+    .out_p(rb_p));
   generate
     for (gi = 0; gi < 3; gi = gi + 1) begin : g_rw
-      ts_mul #(.A_W(Q_W), .B_W(TT_W), .TARGET(TARGET)) u_m (.clk(clk), .rst(rst), .a(tq[0]), .b(rt[gi]), .p(rw[gi]));
+      assign rw[gi] = rb_p[gi*RB_W +: RB_W];
+    end
+    for (gi = 0; gi < 6; gi = gi + 1) begin : g_rc
+      assign rc[gi] = rb_p[(3+gi)*RB_W +: RB_W];
     end
   endgenerate
-  ts_mul #(.A_W(Q_W), .B_W(TT_W), .TARGET(TARGET)) u_rc0 (.clk(clk), .rst(rst), .a(tq[3]), .b(rt[1]), .p(rc[0]));
-  ts_mul #(.A_W(Q_W), .B_W(TT_W), .TARGET(TARGET)) u_rc1 (.clk(clk), .rst(rst), .a(tq[2]), .b(rt[2]), .p(rc[1]));
-  ts_mul #(.A_W(Q_W), .B_W(TT_W), .TARGET(TARGET)) u_rc2 (.clk(clk), .rst(rst), .a(tq[1]), .b(rt[2]), .p(rc[2]));
-  ts_mul #(.A_W(Q_W), .B_W(TT_W), .TARGET(TARGET)) u_rc3 (.clk(clk), .rst(rst), .a(tq[3]), .b(rt[0]), .p(rc[3]));
-  ts_mul #(.A_W(Q_W), .B_W(TT_W), .TARGET(TARGET)) u_rc4 (.clk(clk), .rst(rst), .a(tq[2]), .b(rt[0]), .p(rc[4]));
-  ts_mul #(.A_W(Q_W), .B_W(TT_W), .TARGET(TARGET)) u_rc5 (.clk(clk), .rst(rst), .a(tq[1]), .b(rt[1]), .p(rc[5]));
   wire [3*VI_W-1:0] rv_d;
   ts_delay #(.W(3*VI_W), .DEPTH(RLA+MRB)) u_rvd (
     .clk(clk), .rst(rst), .din({rv[2], rv[1], rv[0]}), .dout(rv_d));
@@ -519,9 +557,7 @@ module ts_core_law #(
   reg have_ep, have_eo, have_ffw, have_ffv;
 
   // ---- stage D: V_w = cvt<vel_t>(ff_w + ko eo), V_v = cvt<vel_t>(ff_v + kp ep) --------------------
-  localparam MLW = ts_mul_lat(G_W, RO_W);
-  localparam MLV = ts_mul_lat(G_W, PE_W);
-  localparam MLG = ts_max(MLW, MLV);
+  localparam MLG = ts_bank_lat(G_W, RO_W, FOLD);
   localparam PW_I = G_W - G_F + RO_W - RO_F;
   localparam PW_F = G_F + RO_F;
   localparam PV_I = G_W - G_F + PE_W - PE_F;
@@ -533,14 +569,18 @@ module ts_core_law #(
   wire signed [V_W-1:0] vw_o [0:2];
   wire signed [V_W-1:0] vv_o [0:2];
   wire [2:0] vw_sat, vv_sat;
+  // products 0-2: ko eo_i; 3-5: kp ep_i (rot_t and perr_t have the same width)
+  wire [6*(G_W+RO_W)-1:0] gv_p;
+  ts_mul_bank #(.N(6), .FOLD(FOLD), .A_W(G_W), .B_W(RO_W), .TARGET(TARGET)) u_mg (
+    .clk(clk), .rst(rst), .in_valid(d0),
+    .in_a({r_kp, r_kp, r_kp, r_ko, r_ko, r_ko}), .in_b({ep[2], ep[1], ep[0], eo[2], eo[1], eo[0]}),
+    .out_p(gv_p));
   generate
     for (gi = 0; gi < 3; gi = gi + 1) begin : g_v
       wire signed [V_W-1:0] fw = !r_ff ? {V_W{1'b0}} : (r_mb ? ffw[gi] : uw[gi]);
       wire signed [V_W-1:0] fv = !r_ff ? {V_W{1'b0}} : (r_mb ? ffv[gi] : uv[gi]);
-      wire signed [G_W+RO_W-1:0] pwm;
-      wire signed [G_W+PE_W-1:0] pvm;
-      ts_mul #(.A_W(G_W), .B_W(RO_W), .TARGET(TARGET)) u_mw (.clk(clk), .rst(rst), .a(r_ko), .b(eo[gi]), .p(pwm));
-      ts_mul #(.A_W(G_W), .B_W(PE_W), .TARGET(TARGET)) u_mv (.clk(clk), .rst(rst), .a(r_kp), .b(ep[gi]), .p(pvm));
+      wire signed [G_W+RO_W-1:0] pwm = gv_p[gi*(G_W+RO_W) +: G_W+RO_W];
+      wire signed [G_W+PE_W-1:0] pvm = gv_p[(3+gi)*(G_W+RO_W) +: G_W+PE_W];
       wire signed [SW_W-1:0] wa, wb;
       wire signed [SV_W-1:0] va, vb;
       ts_resize #(.IN_W(V_W), .LSH(SW_F-V_F), .OUT_W(SW_W)) u_wa (.in(fw), .out(wa));
@@ -574,7 +614,7 @@ module ts_core_law #(
       out_busy <= 1'b0;
       out_done <= 1'b0;
       out_flags <= 16'd0;
-      s0 <= 1'b0; b0 <= 1'b0; b1 <= 1'b0; c0 <= 1'b0; c1 <= 1'b0; c2 <= 1'b0; d0 <= 1'b0;
+      s0 <= 1'b0; b0 <= 1'b0; c0 <= 1'b0; c1 <= 1'b0; c2 <= 1'b0; d0 <= 1'b0;
       d_issued <= 1'b0;
       have_ep <= 1'b0; have_eo <= 1'b0; have_ffw <= 1'b0; have_ffv <= 1'b0;
       fr <= {RV_W{1'b0}};
@@ -598,7 +638,6 @@ module ts_core_law #(
     end else begin
       s0 <= start;
       b0 <= 1'b0;
-      b1 <= b0;
       c0 <= 1'b0;
       c1 <= 1'b0;
       c2 <= 1'b0;

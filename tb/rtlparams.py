@@ -210,7 +210,7 @@ DEPS["ts_core_fk"] = ["ts_joint_quat", "ts_sincos", "ts_quat_mul", "ts_quat_rota
                       "ts_resize", "ts_delay", "ts_round_sat"]
 DEPS["ts_core_commit"] = ["ts_mul", "ts_resize", "ts_delay", "ts_ecp5_mult18", "ts_sel"]
 DEPS["ts_core_solve"] = ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat", "ts_ecp5_mult18"]
-DEPS["ts_core_law"] = ["ts_quat_mul", "ts_quat_rotate", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"]
+DEPS["ts_core_law"] = ["ts_quat_mul", "ts_quat_rotate", "ts_mul_bank", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"]
 DEPS["ts_servo_core"] = ["ts_servo_regs", "ts_core_commit", "ts_core_fk", "ts_core_law", "ts_core_solve", "ts_sel"]
 DEPS["ts_servo_regs"] = []
 #: the datapath modules (documented, synthesised); the others are shared pieces
