@@ -206,21 +206,29 @@ inline void solver_prepare(const SolverParams<Fmt, NMAX>& P, const Jacobian<Fmt,
   solver_steps(P, q, J.n, C, st);
 }
 
+// Leading-one position of max |v[i]| over i < m; LEAD_NONE when every v[i] is zero.
+constexpr int LEAD_NONE = -(1 << 20);
+template <int M, class V>
+inline int lead_exp(const V* v, int m) {
+  int top = LEAD_NONE;
+  for (int i = 0; i < M; ++i) {
+    if (i >= m) continue;
+    const int ki = v[i] < V{} ? ilog2(-v[i]) : ilog2(v[i]);
+    top = ki > top ? ki : top;
+  }
+  return top;
+}
+
 // Block floating point: out[i] = v[i] 2^-k rounded to bfm_t with k = 1 + the leading-one position
 // of max |v[i]|, so 1/2 <= max |out| <= 1 and rounding never saturates (bfm_t has 2 integer bits).
 // Returns false (out zero, k = 0) when every v[i] (i < m) is zero.
 template <class Fmt, int M, class V>
 inline bool block_norm(const V* v, int m, typename Fmt::bfm_t* out, int& k, Status& st) {
   using bfm_t = typename Fmt::bfm_t;
-  int top = -(1 << 20);
-  for (int i = 0; i < M; ++i) {
-    if (i >= m) continue;
-    const int ki = v[i] < V{} ? ilog2(-v[i]) : ilog2(v[i]);
-    top = ki > top ? ki : top;
-  }
-  k = top > -(1 << 20) ? top + 1 : 0;
-  for (int i = 0; i < M; ++i) out[i] = i < m && top > -(1 << 20) ? cvt_shr<bfm_t>(v[i], k, st) : bfm_t{};
-  return top > -(1 << 20);
+  const int top = lead_exp<M>(v, m);
+  k = top > LEAD_NONE ? top + 1 : 0;
+  for (int i = 0; i < M; ++i) out[i] = i < m && top > LEAD_NONE ? cvt_shr<bfm_t>(v[i], k, st) : bfm_t{};
+  return top > LEAD_NONE;
 }
 
 // Exact combination out[a] = sum_i js[i][a] x[i] of the scaled columns (rows a < rows, joints
@@ -274,7 +282,6 @@ inline void solver_cg(const SolverParams<Fmt, NMAX>& P, const SolverColumns<Fmt,
   using G = decltype(dot_exact<Fmt, ROWS>(C.js[0], static_cast<const bfm_t*>(nullptr), 0));
   using Y = decltype(columns_times<Fmt, NMAX, ROWS>(C.js, static_cast<const bfm_t*>(nullptr), 0, 0));
   using U = decltype(bfm_t{} + bfm_t{});
-  constexpr int NONE = -(1 << 20);
   const int rows = C.rows;
   const auto one = one_of<typename Fmt::mu_t>();
   bool use[NMAX];
@@ -284,7 +291,8 @@ inline void solver_cg(const SolverParams<Fmt, NMAX>& P, const SolverColumns<Fmt,
   G g[NMAX];
   Y y[ROWS];
   U u[NMAX];
-  int k0 = 0, kr = 0, ks = 0, kp = 0, kw = 0, kz = 0, kd = 0, kn = 0;
+  int k0 = 0, kr = 0, kw = 0, kz = 0, kd = 0, kn = 0;
+  int kdir = 0;                         // exponent of s and p: not needed (a direction's scale cancels)
   cgy_t yw{};                           // 2^(kd + 1) / |w|^2, in [1, 2]
   if (!block_norm<Fmt, ROWS>(racc, rows, rn, k0, st)) return;
   for (int a = 0; a < ROWS; ++a) rr[a] = a < rows ? cvt_shr<cgr_t>(racc[a], k0, st) : cgr_t{};
@@ -310,7 +318,7 @@ inline void solver_cg(const SolverParams<Fmt, NMAX>& P, const SolverColumns<Fmt,
                  !(!(qd[i] < C.hi[i]) && G{} < g[i]);
       if (!use[i]) g[i] = G{};
     }
-    if (!block_norm<Fmt, NMAX>(g, n, s, ks, st)) break;
+    if (!block_norm<Fmt, NMAX>(g, n, s, kdir, st)) break;
     // direction: p = s at the first step, then p = s + beta p, beta = -<A s, A p> / |A p|^2 = bt 2^eb
     if (it == 0) {
       for (int i = 0; i < NMAX; ++i) p[i] = s[i];
@@ -326,17 +334,13 @@ inline void solver_cg(const SolverParams<Fmt, NMAX>& P, const SolverColumns<Fmt,
         eb = kn - kd + kz - kw;
       }
       // s + bt p 2^eb, both terms scaled by 2^-E (E: the larger term's exponent), renormalised
-      int kt = NONE;
-      for (int i = 0; i < NMAX; ++i) {
-        if (i >= n) continue;
-        const auto t = bt * p[i];
-        const int ki = t < decltype(t){} ? ilog2(-t) : ilog2(t);
-        kt = ki > kt ? ki : kt;
-      }
-      const int E = (kt > NONE && kt + eb + 1 > 0) ? kt + eb + 1 : 0;
+      decltype(bt * p[0]) t[NMAX];
+      for (int i = 0; i < NMAX; ++i) t[i] = bt * p[i];
+      const int kt = lead_exp<NMAX>(t, n);
+      const int E = (kt > LEAD_NONE && kt + eb + 1 > 0) ? kt + eb + 1 : 0;
       for (int i = 0; i < NMAX; ++i)
-        if (i < n) u[i] = cvt_shr<bfm_t>(s[i], E, st) + cvt_shr<bfm_t>(bt * p[i], E - eb, st);
-      if (!block_norm<Fmt, NMAX>(u, n, p, kp, st)) break;
+        if (i < n) u[i] = cvt_shr<bfm_t>(s[i], E, st) + cvt_shr<bfm_t>(t[i], E - eb, st);
+      if (!block_norm<Fmt, NMAX>(u, n, p, kdir, st)) break;
     }
     // w = A p, |w|^2 = m 2^(kd + 1) with m in [1/2, 1], yw = 1/m
     for (int a = 0; a < ROWS; ++a)
