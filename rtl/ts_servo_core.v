@@ -24,11 +24,12 @@ module ts_servo_core #(
   parameter TRIG_ROM = (CONFIG == 0) ? "ts_trig_rom_default.mem" : "ts_trig_rom_compact.mem",
   parameter RECIP_ROM = (CONFIG == 0) ? "ts_recip_rom_default.mem" : "ts_recip_rom_compact.mem",
   parameter ROTVEC_ROM = (CONFIG == 0) ? "ts_rotvec_rom_default.mem" : "ts_rotvec_rom_compact.mem",
-  // Products per multiplier in the FK and law engines' quaternion product, rotation and screw
-  // transport units (ts_mul_bank; 1: fully parallel).  The bits never depend on it; the cycle
-  // count of a tick does (docs/resources.md).  Up to 7 it costs no column throughput (the
-  // solver takes a column per 7 cycles).
-  parameter FOLD = 7
+  // Products per multiplier of the FK and law engines' product units (ts_mul_bank; 1: fully
+  // parallel).  The bits never depend on it; the cycle count of a tick does (docs/resources.md).
+  // Default: the smallest fold at which the core's MULT18X18D fit the budget of its device
+  // (default configuration: 9, about 143 of LFE5U-85F's 156; compact: 7, about 44 of LFE5U-45F's
+  // 72; up to 7 it costs no column throughput, as the solver takes a column per 7 cycles).
+  parameter FOLD = (CONFIG == 0) ? 9 : 7
 ) (
   input  wire        clk,
   input  wire        rst,

