@@ -538,8 +538,10 @@ module ts_servo_core #(
         end
         S_IN: begin
           if (beat_in) begin
-            if ((wi <= n_w) && (wi != 0))
-              qbuf[qi*ANGLE_W +: ANGLE_W] <= s_axis_tdata[ANGLE_W-1:0];
+            if ((wi <= n_w) && (wi != 0)) begin
+              for (k = 0; k < JN; k = k + 1)
+                if ({{(32 - JI_W){1'b0}}, qi} == k) qbuf[k*ANGLE_W +: ANGLE_W] <= s_axis_tdata[ANGLE_W-1:0];
+            end
             else if ((wi > n_w) && (wi <= last_in)) sp[si] <= s_axis_tdata;
             if (wi != {WI_W{1'b1}}) wi <= wi + 1'b1;
             if (s_axis_tlast) begin
