@@ -321,6 +321,9 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
     for iw, l, ow in ((8, 0, 12), (8, 0, 8), (12, 0, 8), (8, 3, 14), (8, 3, 11), (8, 3, 9)):
         jobs.append(("ts_resize", sources("ts_resize"), {"IN_W": iw, "LSH": l, "OUT_W": ow}))
     jobs.append(("ts_ecp5_mult18", sources("ts_ecp5_mult18", "ECP5"), {}))
+    # the multiplexer: the shapes of its bench (power of two, padded, index bits above the tree, one element)
+    for w, n, iw in ((18, 8, 3), (32, 6, 3), (27, 20, 5), (18, 7, 3), (27, 9, 4), (5, 1, 1)):
+        jobs.append(("ts_sel", sources("ts_sel"), {"W": w, "N": n, "IW": iw}))
     # the multiplier bank: parallel, folded with and without padding slots, one multiplier
     for n, fold in ((6, 1), (16, 4), (9, 7), (6, 6), (3, 7)):
         for target in TARGETS:

@@ -1,6 +1,6 @@
 """Bench of rtl/ts_sel.v (combinational): out_el = element in_idx of in_vec (element k at
 [k*W +: W]), 0 for in_idx >= N; every index, random buses, for the shapes the core uses (N a power
-of two, N = 6 with a 3-bit index, N = 20 with a 5-bit index)."""
+of two, N = 6 with a 3-bit index, N = 20 with a 5-bit index, the banks' N = FOLD, one element)."""
 import os
 
 import pytest
@@ -8,7 +8,7 @@ import pytest
 import tsbench
 
 N_RANDOM = int(os.environ.get("TS_NVEC", "2000"))
-SHAPES = [(18, 8, 3), (32, 6, 3), (27, 20, 5)]    # (W, N, IW)
+SHAPES = [(18, 8, 3), (32, 6, 3), (27, 20, 5), (18, 7, 3), (27, 9, 4), (5, 1, 1)]    # (W, N, IW): core selects, bank phases, one element
 
 try:
     import cocotb
