@@ -10,7 +10,7 @@ flags).  PUMA 560 and Panda, from their benchmark start poses, are also compared
 model: the core's tool path within 4 LSB of the position-error format of the float one over the
 second half of the run (docs/numerics.md, tracking).
 
-Ticks per run: TS_RTL_TICKS (default 150 at 10 sweeps); ``make soak`` runs 10,000 ticks per chain
+Ticks per run: TS_RTL_TICKS (default 100 at 10 sweeps); ``make soak`` runs 10,000 ticks per chain
 and configuration at 2 sweeps (TS_RTL_TICKS=10000 TS_RTL_SWEEPS=2); TS_SEED replays the random
 chain.  The 20-joint chain runs through the core built with NMAX = 20 in ``make soak`` (or with
 TS_RTL_WIDE=1).  The CLI test checks ``tservo track --model rtl`` output files against ``--model fixed``
@@ -34,7 +34,7 @@ from tensor_servo.randchain import random_chain
 from tensor_servo.rtl_core import core_nmax
 from tensor_servo.track import make_tick, relative_poses, run_model
 
-NT = int(os.environ.get("TS_RTL_TICKS", "150"))
+NT = int(os.environ.get("TS_RTL_TICKS", "100"))
 SWEEPS = int(os.environ.get("TS_RTL_SWEEPS", "10"))
 SEED = int(os.environ.get("TS_SEED", str(np.random.SeedSequence().entropy % 2**31)))
 CHAINS = {"puma560": {"mode": "A"}, "ur5": {"feedforward": False}, "panda": {"mode": "B"},
