@@ -11,7 +11,7 @@
 //   prismatic: z_i = R(QF) a_i               (the rotation inside ts_screw_transport)
 //              d = cvt<lever_t>(s q_i),  p_i = cvt<pos_t>(pF + d z_i),  Q_i = QF
 //   tool:      Q_T = Q_n (x) Qt,  p_T = cvt<pos_t>(p_n + R(Q_n) pt)
-// then the n columns, streamed through ts_screw_transport (II = 1):
+// then the n columns, streamed through ts_screw_transport (one per FOLD cycles, its II):
 //   z_i = R(QF_i) a_i;  revolute: w = cvt<jw_t>(s z_i), v = cross<jv_t>(w, cvt<lever_t>(p_T - p_i));
 //   prismatic: w = 0, v = cvt<jv_t>(s z_i).
 // One shared instance of each primitive; a sequencer walks the joints (docs/rtl/ts_core_fk.md).
