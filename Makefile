@@ -95,7 +95,7 @@ $(BIND_STAMP): $(BIND_OBJS)
 test: setup
 	$(BUILD)/model_tests/run_tests
 	$(BUILD)/model_tests/operand_widths
-	$(PY) -m pytest -n $(JOBS) -q
+	$(PY) -m pytest -n $(JOBS) -q --durations=30
 
 test-cpp: build
 	$(BUILD)/model_tests/run_tests
