@@ -100,7 +100,7 @@ def _runners():
 #: The primitives' benches stream 10,000 fresh random vectors per run on Verilator; Icarus is 10-50x
 #: slower on them, so its runs take ICARUS_NVEC (the same code path, a second simulator's check)
 #: unless TS_NVEC is set.  Keeps make test within its time budget on 2 cores.
-ICARUS_NVEC = 1000
+ICARUS_NVEC = 2500
 ICARUS_NVEC_MODULES = ("ts_quat_mul", "ts_quat_rotate", "ts_sincos", "ts_joint_quat", "ts_screw_transport",
                        "ts_round_sat", "ts_mul", "ts_delay", "ts_resize")
 
