@@ -30,6 +30,20 @@ function integer ts_bank_lat;
   end
 endfunction
 
+// Latency of ts_quat_rotate (q of width qw, vector vw, intermediate t tw; fold as its FOLD): stage A
+// products, a registered difference and the rounding of t, then stage B products, two adder
+// levels and the output rounding.  The law's own rotation has the same pipeline.
+function integer ts_rotate_lat;
+  input integer qw;
+  input integer vw;
+  input integer tw;
+  input integer fold;
+  begin
+    ts_rotate_lat = ts_bank_lat(qw, vw, fold) + 1 + ts_round_lat(1) + ts_bank_lat(qw, tw, fold) + 2 +
+                    ts_round_lat(1);
+  end
+endfunction
+
 function integer ts_max;
   input integer x;
   input integer y;

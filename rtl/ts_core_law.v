@@ -394,7 +394,7 @@ module ts_core_law #(
   localparam MRA = ts_bank_lat(Q_W, VI_W, FOLD);
   localparam MRB = ts_bank_lat(Q_W, TT_W, FOLD);
   localparam RLA = MRA + 1 + RL;                 // t available
-  localparam ROT_LAT = RLA + MRB + 2 + RL;
+  localparam ROT_LAT = ts_rotate_lat(Q_W, VI_W, TT_W, FOLD);   // = RLA + MRB + 2 + RL
   localparam RA_W = Q_W + VI_W;
   localparam RB_W = Q_W + TT_W;
   localparam LS0 = Q_F + TF0 - VF0;              // alignment of v to the stage-B products
@@ -730,7 +730,7 @@ module ts_core_law #(
   end
 
   // ---- column port ----------------------------------------------------------------------------------
-  localparam COL_LAT = ts_bank_lat(Q_W, JW_W, FOLD) + ts_bank_lat(Q_W, TS_JW_TMP_W, FOLD) + 3 + 2 * RL;
+  localparam COL_LAT = ts_rotate_lat(Q_W, JW_W, TS_JW_TMP_W, FOLD);   // ts_quat_rotate
   wire col_ovalid, col_ovalid_v, col_sw, col_sv;
   wire signed [JW_W-1:0] cw_o [0:2];
   wire signed [JV_W-1:0] cv_o [0:2];

@@ -63,7 +63,7 @@ module ts_quat_rotate #(
   localparam MLB = ts_bank_lat(Q_W, T_W, FOLD);
   // Stage A latency (t available), total latency.
   localparam LA = MLA + 1 + ts_round_lat(1);
-  localparam LATENCY = LA + MLB + 2 + ts_round_lat(1);
+  localparam LATENCY = ts_rotate_lat(Q_W, V_W, T_W, FOLD);   // = LA + MLB + 2 + ts_round_lat(1)
 
   // ---- stage A: t = 2 q_v x v ---------------------------------------------------------------
   localparam PA_W = Q_W + V_W;

@@ -83,7 +83,7 @@ module ts_screw_transport #(
   `include "ts_common.vh"
 
   localparam RL = ts_round_lat(1);
-  localparam LR = ts_bank_lat(Q_W, Q_W, FOLD) + ts_bank_lat(Q_W, UT_W, FOLD) + 3 + 2 * RL;   // ts_quat_rotate
+  localparam LR = ts_rotate_lat(Q_W, Q_W, UT_W, FOLD);   // ts_quat_rotate
   localparam MLS = ts_bank_lat(S_W, Q_W, FOLD);
   localparam MLC = ts_bank_lat(JW_W, L_W, FOLD);
   // Cycle at which r, w (and the prismatic v) and the cross product are available; latency.

@@ -162,14 +162,14 @@ def latency(module: str, p: dict) -> int:
     if module == "ts_quat_mul":
         return bank_lat(p["Q_W"], p["Q_W"], f) + 2 + rl
     if module == "ts_quat_rotate":
-        return bank_lat(p["Q_W"], p["V_W"], f) + bank_lat(p["Q_W"], p["T_W"], f) + 3 + 2 * rl
+        return bank_lat(p["Q_W"], p["V_W"], f) + bank_lat(p["Q_W"], p["T_W"], f) + 3 + 2 * rl   # ts_rotate_lat
     if module == "ts_sincos":
         return sincos_stages(p)["LATENCY"]
     if module == "ts_joint_quat":
         return (mul_lat(p["ANG_W"], p["KT_W"]) + rl + latency("ts_sincos", p)
                 + mul_lat(p["Q_W"], p["Q_W"]) + rl)
     if module == "ts_screw_transport":
-        lr = bank_lat(p["Q_W"], p["Q_W"], f) + bank_lat(p["Q_W"], p["UT_W"], f) + 3 + 2 * rl
+        lr = latency("ts_quat_rotate", {"Q_W": p["Q_W"], "V_W": p["Q_W"], "T_W": p["UT_W"], "FOLD": f})
         cw = lr + bank_lat(p["S_W"], p["Q_W"], f) + rl
         return cw + bank_lat(p["JW_W"], p["L_W"], f) + 1 + rl + 1
     raise KeyError(module)

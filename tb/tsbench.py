@@ -15,6 +15,7 @@ and is printed (pytest side) and logged (cocotb side) so a failure can be replay
 from __future__ import annotations
 
 import fcntl
+import json
 import hashlib
 import os
 import shutil
@@ -155,6 +156,20 @@ def run_bench(*, toplevel: str, test_file: str, sources: list[str], parameters: 
 
 
 # ---- cocotb side -------------------------------------------------------------------------------
+def run_unit(module: str, test_file: str, p: dict, cfg: str, sim: str, fold: int = 1, nvec: int | None = None) -> None:
+    """One bench run of a datapath unit with parameters p; fold > 1 runs its folded form
+    (parameter FOLD, build directory ...-fold<FOLD>), nvec sets TS_NVEC."""
+    from rtlparams import sources
+    target = target_for(sim)
+    if fold > 1:
+        p = dict(p, FOLD=fold)
+    env = {"TS_CONFIG": cfg, "TS_PARAMS": json.dumps(p)}
+    if nvec:
+        env["TS_NVEC"] = str(nvec)
+    run_bench(toplevel=module, test_file=test_file, sources=sources(module, target), parameters=p, sim=sim,
+              build_name=f"{cfg}-{target}-" + (f"fold{fold}" if fold > 1 else sim), env=env)
+
+
 def to_signed(u: int, w: int) -> int:
     """Two's-complement value of a w-bit pattern; 1-bit signals (flags) read as 0/1."""
     if w == 1:

@@ -103,19 +103,12 @@ if cocotb is not None:
 @pytest.mark.parametrize("sim", tsbench.SIMS)
 @pytest.mark.parametrize("cfg", tsbench.CONFIGS)
 def test_ts_screw_transport(cfg, sim):
-    target = tsbench.target_for(sim)
-    p = rtlparams.screw_transport(cfg, target)
-    tsbench.run_bench(toplevel=MODULE, test_file=__file__, sources=rtlparams.sources(MODULE, target),
-                      parameters=p, sim=sim, build_name=f"{cfg}-{target}-{sim}",
-                      env={"TS_CONFIG": cfg, "TS_PARAMS": json.dumps(p)})
+    tsbench.run_unit(MODULE, __file__, rtlparams.screw_transport(cfg, tsbench.target_for(sim)), cfg, sim)
 
 
 @pytest.mark.parametrize("fold", (3,))
 @pytest.mark.parametrize("cfg", ["compact"])    # make test time; the default configuration is folded in the core (harness runs)
 def test_ts_screw_transport_folded(cfg, fold):
     """The folded form (FOLD products per multiplier, II = FOLD): the same bits, the documented latency."""
-    target = tsbench.target_for("verilator")
-    p = dict(rtlparams.screw_transport(cfg, target), FOLD=fold)
-    tsbench.run_bench(toplevel=MODULE, test_file=__file__, sources=rtlparams.sources(MODULE, target),
-                      parameters=p, sim="verilator", build_name=f"{cfg}-{target}-fold{fold}",
-                      env={"TS_CONFIG": cfg, "TS_PARAMS": json.dumps(p), "TS_NVEC": "2000"})
+    tsbench.run_unit(MODULE, __file__, rtlparams.screw_transport(cfg, tsbench.target_for("verilator")), cfg,
+                     "verilator", fold=fold, nvec=2000)

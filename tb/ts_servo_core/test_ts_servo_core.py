@@ -427,7 +427,7 @@ def test_ts_servo_core(cfg, sim):
     cyc_file = tsbench.BUILD / MODULE / f"cycles-{build}.json"
     cyc_file.parent.mkdir(parents=True, exist_ok=True)
     # ticks per robot: the simulators run about 10-40 kcycles/s (Verilator) and 2 kcycles/s (Icarus)
-    nt = os.environ.get("TS_NT", ("10" if cfg == "compact" else "6") if sim == "verilator" else "1")
+    nt = os.environ.get("TS_NT", "6" if sim == "verilator" else "1")
     tsbench.run_bench(toplevel=MODULE, test_file=__file__, sources=sources(target, sim), parameters=p,
                       sim=sim, build_name=build,
                       env={"TS_CONFIG": cfg, "TS_NT": nt, "TS_CYCLES_FILE": str(cyc_file),
