@@ -1,6 +1,15 @@
 // SPDX-License-Identifier: Apache-2.0
-// tensor-servo: fixed delay line of DEPTH clock cycles (shift register, synchronous reset to 0).
-// DEPTH = 0 is a wire.  Used for the valid pipelines and to align operands across the datapaths.
+// tensor-servo: fixed delay line of DEPTH clock cycles (synchronous reset: the output is 0 for the
+// DEPTH cycles after a reset).  DEPTH = 0 is a wire.  Used for the valid pipelines and to align
+// operands across the datapaths.
+// Two implementations with the same output in every cycle, reset included:
+//   RAM = 0: a shift register (DEPTH * W flip-flops);
+//   RAM = 1 (DEPTH >= 3): a ring of DEPTH - 1 words in a memory with an asynchronous read
+//     (distributed RAM on ECP5, TRELLIS_DPR16X4 per 16 words x 4 bits; LUTRAM on 7-series) and one
+//     output register.  The words are not reset: a fill flag holds the output at 0 until every word
+//     has been written since the reset.  W flip-flops and about W / 4 * ceil((DEPTH - 1) / 16)
+//     RAM blocks instead of DEPTH * W flip-flops.
+// The default takes the ring for data lines (W >= 4) of DEPTH >= 3.
 // Language: Verilog 2005
 `resetall
 `timescale 1ns / 1ps
@@ -10,7 +19,9 @@ module ts_delay #(
   // Data width in bits
   parameter W = 1,
   // Delay in clock cycles (>= 0)
-  parameter DEPTH = 1
+  parameter DEPTH = 1,
+  // 1: ring buffer in a memory (DEPTH >= 3), 0: shift register (see the header)
+  parameter RAM = ((W >= 4) && (DEPTH >= 3)) ? 1 : 0
 ) (
   input  wire         clk,
   input  wire         rst,
@@ -27,6 +38,34 @@ module ts_delay #(
       always @(posedge clk) begin
         if (rst) q <= {W{1'b0}};
         else     q <= din;
+      end
+      assign dout = q;
+    end else if ((RAM != 0) && (DEPTH >= 3)) begin : g_ram
+      localparam integer N = DEPTH - 1;                 // ring words
+      localparam integer AW = (N > 1) ? $clog2(N) : 1;
+      localparam integer LAST = N - 1;
+      reg [W-1:0]  mem [0:N-1];
+      reg [AW-1:0] ptr;
+      reg          full;   // every word written since the reset
+      reg [W-1:0]  q;
+      // The word at ptr was written N cycles ago: read it (before this cycle's write) and replace it.
+      always @(posedge clk) begin
+        mem[ptr] <= din;
+      end
+      always @(posedge clk) begin
+        if (rst) begin
+          ptr  <= {AW{1'b0}};
+          full <= 1'b0;
+          q    <= {W{1'b0}};
+        end else begin
+          q <= full ? mem[ptr] : {W{1'b0}};
+          if (ptr == LAST[AW-1:0]) begin
+            ptr  <= {AW{1'b0}};
+            full <= 1'b1;
+          end else begin
+            ptr <= ptr + 1'b1;
+          end
+        end
       end
       assign dout = q;
     end else begin : g_regs

@@ -455,6 +455,7 @@ module ts_servo_regs #(
   // FLAGS bits cleared this cycle: written 1, CTRL.CLEAR
   wire [17:0] flags_clr = (we_flags ? wr_ones[17:0] : 18'd0) | {18{ctrl_clear_q}};
 
+  integer gb;  // bit of a field being written
   always @(posedge clk) begin
     if (rst) begin
       ctrl_run_q <= RST_CTRL_RUN;
@@ -498,10 +499,10 @@ module ts_servo_regs #(
       tool_py_q <= RST_TOOL_PY[LEN_W-1:0];
       tool_pz_q <= RST_TOOL_PZ[LEN_W-1:0];
     end else begin
-      if (we_ctrl) ctrl_run_q <= (ctrl_run_q & ~wr_mask[0]) | wr_ones[0];
+      if (we_ctrl && w_strb[0]) ctrl_run_q <= w_data[0];
       ctrl_commit_q <= we_ctrl ? wr_ones[1] : 1'b0;
       ctrl_clear_q <= we_ctrl ? wr_ones[2] : 1'b0;
-      if (we_ctrl) ctrl_virtual_q <= (ctrl_virtual_q & ~wr_mask[3]) | wr_ones[3];
+      if (we_ctrl && w_strb[0]) ctrl_virtual_q <= w_data[3];
       flags_ovf_angle_q <= in_flags_set[0] | (flags_ovf_angle_q & ~flags_clr[0]);
       flags_ovf_turn_q <= in_flags_set[1] | (flags_ovf_turn_q & ~flags_clr[1]);
       flags_ovf_trig_q <= in_flags_set[2] | (flags_ovf_trig_q & ~flags_clr[2]);
@@ -514,148 +515,148 @@ module ts_servo_regs #(
       flags_ovf_servo_q <= in_flags_set[9] | (flags_ovf_servo_q & ~flags_clr[9]);
       flags_limit_active_q <= in_flags_set[16] | (flags_limit_active_q & ~flags_clr[16]);
       flags_vlimit_active_q <= in_flags_set[17] | (flags_vlimit_active_q & ~flags_clr[17]);
-      if (we_njoints) njoints_q <= (njoints_q & ~wr_mask[7:0]) | wr_ones[7:0];
-      if (we_mode) mode_err_b_q <= (mode_err_b_q & ~wr_mask[0]) | wr_ones[0];
-      if (we_mode) mode_error_only_q <= (mode_error_only_q & ~wr_mask[1]) | wr_ones[1];
-      if (we_mode) mode_sweeps_q <= (mode_sweeps_q & ~wr_mask[15:8]) | wr_ones[15:8];
-      if (we_mode) mode_warm_leak_q <= (mode_warm_leak_q & ~wr_mask[19:16]) | wr_ones[19:16];
-      if (we_kp) kp_q <= (kp_q & ~wr_mask[GAIN_W-1:0]) | wr_ones[GAIN_W-1:0];
-      if (we_ko) ko_q <= (ko_q & ~wr_mask[GAIN_W-1:0]) | wr_ones[GAIN_W-1:0];
-      if (we_lchar) lchar_q <= (lchar_q & ~wr_mask[LCHAR_W-1:0]) | wr_ones[LCHAR_W-1:0];
-      if (we_klim) klim_q <= (klim_q & ~wr_mask[KLIM_W-1:0]) | wr_ones[KLIM_W-1:0];
-      if (we_dt) dt_q <= (dt_q & ~wr_mask[DT_W-1:0]) | wr_ones[DT_W-1:0];
-      if (we_base_qw) base_qw_q <= (base_qw_q & ~wr_mask[QUAT_W-1:0]) | wr_ones[QUAT_W-1:0];
-      if (we_base_qx) base_qx_q <= (base_qx_q & ~wr_mask[QUAT_W-1:0]) | wr_ones[QUAT_W-1:0];
-      if (we_base_qy) base_qy_q <= (base_qy_q & ~wr_mask[QUAT_W-1:0]) | wr_ones[QUAT_W-1:0];
-      if (we_base_qz) base_qz_q <= (base_qz_q & ~wr_mask[QUAT_W-1:0]) | wr_ones[QUAT_W-1:0];
-      if (we_base_px) base_px_q <= (base_px_q & ~wr_mask[LEN_W-1:0]) | wr_ones[LEN_W-1:0];
-      if (we_base_py) base_py_q <= (base_py_q & ~wr_mask[LEN_W-1:0]) | wr_ones[LEN_W-1:0];
-      if (we_base_pz) base_pz_q <= (base_pz_q & ~wr_mask[LEN_W-1:0]) | wr_ones[LEN_W-1:0];
-      if (we_tool_qw) tool_qw_q <= (tool_qw_q & ~wr_mask[QUAT_W-1:0]) | wr_ones[QUAT_W-1:0];
-      if (we_tool_qx) tool_qx_q <= (tool_qx_q & ~wr_mask[QUAT_W-1:0]) | wr_ones[QUAT_W-1:0];
-      if (we_tool_qy) tool_qy_q <= (tool_qy_q & ~wr_mask[QUAT_W-1:0]) | wr_ones[QUAT_W-1:0];
-      if (we_tool_qz) tool_qz_q <= (tool_qz_q & ~wr_mask[QUAT_W-1:0]) | wr_ones[QUAT_W-1:0];
-      if (we_tool_px) tool_px_q <= (tool_px_q & ~wr_mask[LEN_W-1:0]) | wr_ones[LEN_W-1:0];
-      if (we_tool_py) tool_py_q <= (tool_py_q & ~wr_mask[LEN_W-1:0]) | wr_ones[LEN_W-1:0];
-      if (we_tool_pz) tool_pz_q <= (tool_pz_q & ~wr_mask[LEN_W-1:0]) | wr_ones[LEN_W-1:0];
+      if (we_njoints) for (gb = 0; gb < 8; gb = gb + 1) if (w_strb[(0 + gb) / 8]) njoints_q[gb] <= w_data[0 + gb];
+      if (we_mode && w_strb[0]) mode_err_b_q <= w_data[0];
+      if (we_mode && w_strb[0]) mode_error_only_q <= w_data[1];
+      if (we_mode) for (gb = 0; gb < 8; gb = gb + 1) if (w_strb[(8 + gb) / 8]) mode_sweeps_q[gb] <= w_data[8 + gb];
+      if (we_mode) for (gb = 0; gb < 4; gb = gb + 1) if (w_strb[(16 + gb) / 8]) mode_warm_leak_q[gb] <= w_data[16 + gb];
+      if (we_kp) for (gb = 0; gb < GAIN_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) kp_q[gb] <= w_data[0 + gb];
+      if (we_ko) for (gb = 0; gb < GAIN_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) ko_q[gb] <= w_data[0 + gb];
+      if (we_lchar) for (gb = 0; gb < LCHAR_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) lchar_q[gb] <= w_data[0 + gb];
+      if (we_klim) for (gb = 0; gb < KLIM_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) klim_q[gb] <= w_data[0 + gb];
+      if (we_dt) for (gb = 0; gb < DT_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) dt_q[gb] <= w_data[0 + gb];
+      if (we_base_qw) for (gb = 0; gb < QUAT_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) base_qw_q[gb] <= w_data[0 + gb];
+      if (we_base_qx) for (gb = 0; gb < QUAT_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) base_qx_q[gb] <= w_data[0 + gb];
+      if (we_base_qy) for (gb = 0; gb < QUAT_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) base_qy_q[gb] <= w_data[0 + gb];
+      if (we_base_qz) for (gb = 0; gb < QUAT_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) base_qz_q[gb] <= w_data[0 + gb];
+      if (we_base_px) for (gb = 0; gb < LEN_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) base_px_q[gb] <= w_data[0 + gb];
+      if (we_base_py) for (gb = 0; gb < LEN_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) base_py_q[gb] <= w_data[0 + gb];
+      if (we_base_pz) for (gb = 0; gb < LEN_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) base_pz_q[gb] <= w_data[0 + gb];
+      if (we_tool_qw) for (gb = 0; gb < QUAT_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) tool_qw_q[gb] <= w_data[0 + gb];
+      if (we_tool_qx) for (gb = 0; gb < QUAT_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) tool_qx_q[gb] <= w_data[0 + gb];
+      if (we_tool_qy) for (gb = 0; gb < QUAT_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) tool_qy_q[gb] <= w_data[0 + gb];
+      if (we_tool_qz) for (gb = 0; gb < QUAT_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) tool_qz_q[gb] <= w_data[0 + gb];
+      if (we_tool_px) for (gb = 0; gb < LEN_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) tool_px_q[gb] <= w_data[0 + gb];
+      if (we_tool_py) for (gb = 0; gb < LEN_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) tool_py_q[gb] <= w_data[0 + gb];
+      if (we_tool_pz) for (gb = 0; gb < LEN_W; gb = gb + 1) if (w_strb[(0 + gb) / 8]) tool_pz_q[gb] <= w_data[0 + gb];
     end
   end
 
   // Fixed-point values sign-extended to the 32-bit read word
   generate
-    wire [31:0] sx_kp;
-    if (GAIN_W < 32) begin : g_sx_kp
-      assign sx_kp = {{(32-GAIN_W){kp_q[GAIN_W-1]}}, kp_q};
-    end else begin : g_nx_kp
-      assign sx_kp = kp_q;
+    wire [31:0] sx_kp_q;
+    if (GAIN_W < 32) begin : g_sx_kp_q
+      assign sx_kp_q = {{(32-GAIN_W){kp_q[GAIN_W-1]}}, kp_q};
+    end else begin : g_nx_kp_q
+      assign sx_kp_q = kp_q;
     end
-    wire [31:0] sx_ko;
-    if (GAIN_W < 32) begin : g_sx_ko
-      assign sx_ko = {{(32-GAIN_W){ko_q[GAIN_W-1]}}, ko_q};
-    end else begin : g_nx_ko
-      assign sx_ko = ko_q;
+    wire [31:0] sx_ko_q;
+    if (GAIN_W < 32) begin : g_sx_ko_q
+      assign sx_ko_q = {{(32-GAIN_W){ko_q[GAIN_W-1]}}, ko_q};
+    end else begin : g_nx_ko_q
+      assign sx_ko_q = ko_q;
     end
-    wire [31:0] sx_lchar;
-    if (LCHAR_W < 32) begin : g_sx_lchar
-      assign sx_lchar = {{(32-LCHAR_W){lchar_q[LCHAR_W-1]}}, lchar_q};
-    end else begin : g_nx_lchar
-      assign sx_lchar = lchar_q;
+    wire [31:0] sx_lchar_q;
+    if (LCHAR_W < 32) begin : g_sx_lchar_q
+      assign sx_lchar_q = {{(32-LCHAR_W){lchar_q[LCHAR_W-1]}}, lchar_q};
+    end else begin : g_nx_lchar_q
+      assign sx_lchar_q = lchar_q;
     end
-    wire [31:0] sx_klim;
-    if (KLIM_W < 32) begin : g_sx_klim
-      assign sx_klim = {{(32-KLIM_W){klim_q[KLIM_W-1]}}, klim_q};
-    end else begin : g_nx_klim
-      assign sx_klim = klim_q;
+    wire [31:0] sx_klim_q;
+    if (KLIM_W < 32) begin : g_sx_klim_q
+      assign sx_klim_q = {{(32-KLIM_W){klim_q[KLIM_W-1]}}, klim_q};
+    end else begin : g_nx_klim_q
+      assign sx_klim_q = klim_q;
     end
-    wire [31:0] sx_dt;
-    if (DT_W < 32) begin : g_sx_dt
-      assign sx_dt = {{(32-DT_W){dt_q[DT_W-1]}}, dt_q};
-    end else begin : g_nx_dt
-      assign sx_dt = dt_q;
+    wire [31:0] sx_dt_q;
+    if (DT_W < 32) begin : g_sx_dt_q
+      assign sx_dt_q = {{(32-DT_W){dt_q[DT_W-1]}}, dt_q};
+    end else begin : g_nx_dt_q
+      assign sx_dt_q = dt_q;
     end
-    wire [31:0] sx_base_qw;
-    if (QUAT_W < 32) begin : g_sx_base_qw
-      assign sx_base_qw = {{(32-QUAT_W){base_qw_q[QUAT_W-1]}}, base_qw_q};
-    end else begin : g_nx_base_qw
-      assign sx_base_qw = base_qw_q;
+    wire [31:0] sx_base_qw_q;
+    if (QUAT_W < 32) begin : g_sx_base_qw_q
+      assign sx_base_qw_q = {{(32-QUAT_W){base_qw_q[QUAT_W-1]}}, base_qw_q};
+    end else begin : g_nx_base_qw_q
+      assign sx_base_qw_q = base_qw_q;
     end
-    wire [31:0] sx_base_qx;
-    if (QUAT_W < 32) begin : g_sx_base_qx
-      assign sx_base_qx = {{(32-QUAT_W){base_qx_q[QUAT_W-1]}}, base_qx_q};
-    end else begin : g_nx_base_qx
-      assign sx_base_qx = base_qx_q;
+    wire [31:0] sx_base_qx_q;
+    if (QUAT_W < 32) begin : g_sx_base_qx_q
+      assign sx_base_qx_q = {{(32-QUAT_W){base_qx_q[QUAT_W-1]}}, base_qx_q};
+    end else begin : g_nx_base_qx_q
+      assign sx_base_qx_q = base_qx_q;
     end
-    wire [31:0] sx_base_qy;
-    if (QUAT_W < 32) begin : g_sx_base_qy
-      assign sx_base_qy = {{(32-QUAT_W){base_qy_q[QUAT_W-1]}}, base_qy_q};
-    end else begin : g_nx_base_qy
-      assign sx_base_qy = base_qy_q;
+    wire [31:0] sx_base_qy_q;
+    if (QUAT_W < 32) begin : g_sx_base_qy_q
+      assign sx_base_qy_q = {{(32-QUAT_W){base_qy_q[QUAT_W-1]}}, base_qy_q};
+    end else begin : g_nx_base_qy_q
+      assign sx_base_qy_q = base_qy_q;
     end
-    wire [31:0] sx_base_qz;
-    if (QUAT_W < 32) begin : g_sx_base_qz
-      assign sx_base_qz = {{(32-QUAT_W){base_qz_q[QUAT_W-1]}}, base_qz_q};
-    end else begin : g_nx_base_qz
-      assign sx_base_qz = base_qz_q;
+    wire [31:0] sx_base_qz_q;
+    if (QUAT_W < 32) begin : g_sx_base_qz_q
+      assign sx_base_qz_q = {{(32-QUAT_W){base_qz_q[QUAT_W-1]}}, base_qz_q};
+    end else begin : g_nx_base_qz_q
+      assign sx_base_qz_q = base_qz_q;
     end
-    wire [31:0] sx_base_px;
-    if (LEN_W < 32) begin : g_sx_base_px
-      assign sx_base_px = {{(32-LEN_W){base_px_q[LEN_W-1]}}, base_px_q};
-    end else begin : g_nx_base_px
-      assign sx_base_px = base_px_q;
+    wire [31:0] sx_base_px_q;
+    if (LEN_W < 32) begin : g_sx_base_px_q
+      assign sx_base_px_q = {{(32-LEN_W){base_px_q[LEN_W-1]}}, base_px_q};
+    end else begin : g_nx_base_px_q
+      assign sx_base_px_q = base_px_q;
     end
-    wire [31:0] sx_base_py;
-    if (LEN_W < 32) begin : g_sx_base_py
-      assign sx_base_py = {{(32-LEN_W){base_py_q[LEN_W-1]}}, base_py_q};
-    end else begin : g_nx_base_py
-      assign sx_base_py = base_py_q;
+    wire [31:0] sx_base_py_q;
+    if (LEN_W < 32) begin : g_sx_base_py_q
+      assign sx_base_py_q = {{(32-LEN_W){base_py_q[LEN_W-1]}}, base_py_q};
+    end else begin : g_nx_base_py_q
+      assign sx_base_py_q = base_py_q;
     end
-    wire [31:0] sx_base_pz;
-    if (LEN_W < 32) begin : g_sx_base_pz
-      assign sx_base_pz = {{(32-LEN_W){base_pz_q[LEN_W-1]}}, base_pz_q};
-    end else begin : g_nx_base_pz
-      assign sx_base_pz = base_pz_q;
+    wire [31:0] sx_base_pz_q;
+    if (LEN_W < 32) begin : g_sx_base_pz_q
+      assign sx_base_pz_q = {{(32-LEN_W){base_pz_q[LEN_W-1]}}, base_pz_q};
+    end else begin : g_nx_base_pz_q
+      assign sx_base_pz_q = base_pz_q;
     end
-    wire [31:0] sx_tool_qw;
-    if (QUAT_W < 32) begin : g_sx_tool_qw
-      assign sx_tool_qw = {{(32-QUAT_W){tool_qw_q[QUAT_W-1]}}, tool_qw_q};
-    end else begin : g_nx_tool_qw
-      assign sx_tool_qw = tool_qw_q;
+    wire [31:0] sx_tool_qw_q;
+    if (QUAT_W < 32) begin : g_sx_tool_qw_q
+      assign sx_tool_qw_q = {{(32-QUAT_W){tool_qw_q[QUAT_W-1]}}, tool_qw_q};
+    end else begin : g_nx_tool_qw_q
+      assign sx_tool_qw_q = tool_qw_q;
     end
-    wire [31:0] sx_tool_qx;
-    if (QUAT_W < 32) begin : g_sx_tool_qx
-      assign sx_tool_qx = {{(32-QUAT_W){tool_qx_q[QUAT_W-1]}}, tool_qx_q};
-    end else begin : g_nx_tool_qx
-      assign sx_tool_qx = tool_qx_q;
+    wire [31:0] sx_tool_qx_q;
+    if (QUAT_W < 32) begin : g_sx_tool_qx_q
+      assign sx_tool_qx_q = {{(32-QUAT_W){tool_qx_q[QUAT_W-1]}}, tool_qx_q};
+    end else begin : g_nx_tool_qx_q
+      assign sx_tool_qx_q = tool_qx_q;
     end
-    wire [31:0] sx_tool_qy;
-    if (QUAT_W < 32) begin : g_sx_tool_qy
-      assign sx_tool_qy = {{(32-QUAT_W){tool_qy_q[QUAT_W-1]}}, tool_qy_q};
-    end else begin : g_nx_tool_qy
-      assign sx_tool_qy = tool_qy_q;
+    wire [31:0] sx_tool_qy_q;
+    if (QUAT_W < 32) begin : g_sx_tool_qy_q
+      assign sx_tool_qy_q = {{(32-QUAT_W){tool_qy_q[QUAT_W-1]}}, tool_qy_q};
+    end else begin : g_nx_tool_qy_q
+      assign sx_tool_qy_q = tool_qy_q;
     end
-    wire [31:0] sx_tool_qz;
-    if (QUAT_W < 32) begin : g_sx_tool_qz
-      assign sx_tool_qz = {{(32-QUAT_W){tool_qz_q[QUAT_W-1]}}, tool_qz_q};
-    end else begin : g_nx_tool_qz
-      assign sx_tool_qz = tool_qz_q;
+    wire [31:0] sx_tool_qz_q;
+    if (QUAT_W < 32) begin : g_sx_tool_qz_q
+      assign sx_tool_qz_q = {{(32-QUAT_W){tool_qz_q[QUAT_W-1]}}, tool_qz_q};
+    end else begin : g_nx_tool_qz_q
+      assign sx_tool_qz_q = tool_qz_q;
     end
-    wire [31:0] sx_tool_px;
-    if (LEN_W < 32) begin : g_sx_tool_px
-      assign sx_tool_px = {{(32-LEN_W){tool_px_q[LEN_W-1]}}, tool_px_q};
-    end else begin : g_nx_tool_px
-      assign sx_tool_px = tool_px_q;
+    wire [31:0] sx_tool_px_q;
+    if (LEN_W < 32) begin : g_sx_tool_px_q
+      assign sx_tool_px_q = {{(32-LEN_W){tool_px_q[LEN_W-1]}}, tool_px_q};
+    end else begin : g_nx_tool_px_q
+      assign sx_tool_px_q = tool_px_q;
     end
-    wire [31:0] sx_tool_py;
-    if (LEN_W < 32) begin : g_sx_tool_py
-      assign sx_tool_py = {{(32-LEN_W){tool_py_q[LEN_W-1]}}, tool_py_q};
-    end else begin : g_nx_tool_py
-      assign sx_tool_py = tool_py_q;
+    wire [31:0] sx_tool_py_q;
+    if (LEN_W < 32) begin : g_sx_tool_py_q
+      assign sx_tool_py_q = {{(32-LEN_W){tool_py_q[LEN_W-1]}}, tool_py_q};
+    end else begin : g_nx_tool_py_q
+      assign sx_tool_py_q = tool_py_q;
     end
-    wire [31:0] sx_tool_pz;
-    if (LEN_W < 32) begin : g_sx_tool_pz
-      assign sx_tool_pz = {{(32-LEN_W){tool_pz_q[LEN_W-1]}}, tool_pz_q};
-    end else begin : g_nx_tool_pz
-      assign sx_tool_pz = tool_pz_q;
+    wire [31:0] sx_tool_pz_q;
+    if (LEN_W < 32) begin : g_sx_tool_pz_q
+      assign sx_tool_pz_q = {{(32-LEN_W){tool_pz_q[LEN_W-1]}}, tool_pz_q};
+    end else begin : g_nx_tool_pz_q
+      assign sx_tool_pz_q = tool_pz_q;
     end
   endgenerate
 
@@ -713,38 +714,53 @@ module ts_servo_regs #(
   wire [31:0] rd_njoints = {24'd0, njoints_q};
   wire [31:0] rd_mode = {12'd0, mode_warm_leak_q, mode_sweeps_q, 6'd0,
       mode_error_only_q, mode_err_b_q};
-  wire [31:0] rd_kp = sx_kp;
-  wire [31:0] rd_ko = sx_ko;
-  wire [31:0] rd_lchar = sx_lchar;
-  wire [31:0] rd_klim = sx_klim;
-  wire [31:0] rd_dt = sx_dt;
-  wire [31:0] rd_base_qw = sx_base_qw;
-  wire [31:0] rd_base_qx = sx_base_qx;
-  wire [31:0] rd_base_qy = sx_base_qy;
-  wire [31:0] rd_base_qz = sx_base_qz;
-  wire [31:0] rd_base_px = sx_base_px;
-  wire [31:0] rd_base_py = sx_base_py;
-  wire [31:0] rd_base_pz = sx_base_pz;
-  wire [31:0] rd_tool_qw = sx_tool_qw;
-  wire [31:0] rd_tool_qx = sx_tool_qx;
-  wire [31:0] rd_tool_qy = sx_tool_qy;
-  wire [31:0] rd_tool_qz = sx_tool_qz;
-  wire [31:0] rd_tool_px = sx_tool_px;
-  wire [31:0] rd_tool_py = sx_tool_py;
-  wire [31:0] rd_tool_pz = sx_tool_pz;
+  wire [31:0] rd_kp = sx_kp_q;
+  wire [31:0] rd_ko = sx_ko_q;
+  wire [31:0] rd_lchar = sx_lchar_q;
+  wire [31:0] rd_klim = sx_klim_q;
+  wire [31:0] rd_dt = sx_dt_q;
+  wire [31:0] rd_base_qw = sx_base_qw_q;
+  wire [31:0] rd_base_qx = sx_base_qx_q;
+  wire [31:0] rd_base_qy = sx_base_qy_q;
+  wire [31:0] rd_base_qz = sx_base_qz_q;
+  wire [31:0] rd_base_px = sx_base_px_q;
+  wire [31:0] rd_base_py = sx_base_py_q;
+  wire [31:0] rd_base_pz = sx_base_pz_q;
+  wire [31:0] rd_tool_qw = sx_tool_qw_q;
+  wire [31:0] rd_tool_qx = sx_tool_qx_q;
+  wire [31:0] rd_tool_qy = sx_tool_qy_q;
+  wire [31:0] rd_tool_qz = sx_tool_qz_q;
+  wire [31:0] rd_tool_px = sx_tool_px_q;
+  wire [31:0] rd_tool_py = sx_tool_py_q;
+  wire [31:0] rd_tool_pz = sx_tool_pz_q;
 
   // ---- joint blocks ---------------------------------------------------------------------
-  // Read word of the addressed joint: OR of the joints' words, all but the addressed one zero
-  wire [NMAX*32-1:0] rd_jnt_words;
-  reg  [31:0] rd_jnt_data;
-  integer k;
-  always @* begin
-    rd_jnt_data = 32'd0;
-    for (k = 0; k < NMAX; k = k + 1)
-      rd_jnt_data = rd_jnt_data | rd_jnt_words[k*32 +: 32];
-  end
+  // Every joint's stored fields side by side (field offsets JO_*, JV_W bits per joint)
+  localparam integer JO_JCFG_PRISMATIC = 0;
+  localparam integer JO_JCFG_LIMITED = JO_JCFG_PRISMATIC + 1;
+  localparam integer JO_JCFG_VLIMITED = JO_JCFG_LIMITED + 1;
+  localparam integer JO_ORIGIN_QW = JO_JCFG_VLIMITED + 1;
+  localparam integer JO_ORIGIN_QX = JO_ORIGIN_QW + QUAT_W;
+  localparam integer JO_ORIGIN_QY = JO_ORIGIN_QX + QUAT_W;
+  localparam integer JO_ORIGIN_QZ = JO_ORIGIN_QY + QUAT_W;
+  localparam integer JO_ORIGIN_PX = JO_ORIGIN_QZ + QUAT_W;
+  localparam integer JO_ORIGIN_PY = JO_ORIGIN_PX + LEN_W;
+  localparam integer JO_ORIGIN_PZ = JO_ORIGIN_PY + LEN_W;
+  localparam integer JO_AXIS_X = JO_ORIGIN_PZ + LEN_W;
+  localparam integer JO_AXIS_Y = JO_AXIS_X + QUAT_W;
+  localparam integer JO_AXIS_Z = JO_AXIS_Y + QUAT_W;
+  localparam integer JO_SCALE = JO_AXIS_Z + QUAT_W;
+  localparam integer JO_LOWER = JO_SCALE + SCALE_W;
+  localparam integer JO_UPPER = JO_LOWER + ANGLE_W;
+  localparam integer JO_VMAX = JO_UPPER + ANGLE_W;
+  localparam integer JO_MU = JO_VMAX + QD_W;
+  localparam integer JV_W = JO_MU + MU_W;
+  wire [NMAX*JV_W-1:0] jnt_vec;
   // Every word of a joint block is a register.
   wire        rd_jnt_ok = 1'b1;
+
+  // Word of the joint block being written, one-hot
+  wire [15:0] wr_jword = 16'd1 << aw_word[3:0];
 
   genvar j;
   generate
@@ -769,6 +785,7 @@ module ts_servo_regs #(
       reg signed [ANGLE_W-1:0] joint_upper_q;
       reg signed [QD_W-1:0] joint_vmax_q;
       reg signed [MU_W-1:0] joint_mu_q;
+      integer jb;  // bit of a field being written
 
       always @(posedge clk) begin
         if (rst) begin
@@ -791,200 +808,237 @@ module ts_servo_regs #(
           joint_vmax_q <= RST_JOINT_VMAX[QD_W-1:0];
           joint_mu_q <= RST_JOINT_MU[MU_W-1:0];
         end else if (we) begin
-          case (aw_word[3:0])
-            4'h0: begin
-              joint_jcfg_prismatic_q <= (joint_jcfg_prismatic_q & ~wr_mask[0]) | wr_ones[0];
-              joint_jcfg_limited_q <= (joint_jcfg_limited_q & ~wr_mask[1]) | wr_ones[1];
-              joint_jcfg_vlimited_q <= (joint_jcfg_vlimited_q & ~wr_mask[2]) | wr_ones[2];
-            end
-            4'h1: begin
-              joint_origin_qw_q <= (joint_origin_qw_q & ~wr_mask[QUAT_W-1:0]) | wr_ones[QUAT_W-1:0];
-            end
-            4'h2: begin
-              joint_origin_qx_q <= (joint_origin_qx_q & ~wr_mask[QUAT_W-1:0]) | wr_ones[QUAT_W-1:0];
-            end
-            4'h3: begin
-              joint_origin_qy_q <= (joint_origin_qy_q & ~wr_mask[QUAT_W-1:0]) | wr_ones[QUAT_W-1:0];
-            end
-            4'h4: begin
-              joint_origin_qz_q <= (joint_origin_qz_q & ~wr_mask[QUAT_W-1:0]) | wr_ones[QUAT_W-1:0];
-            end
-            4'h5: begin
-              joint_origin_px_q <= (joint_origin_px_q & ~wr_mask[LEN_W-1:0]) | wr_ones[LEN_W-1:0];
-            end
-            4'h6: begin
-              joint_origin_py_q <= (joint_origin_py_q & ~wr_mask[LEN_W-1:0]) | wr_ones[LEN_W-1:0];
-            end
-            4'h7: begin
-              joint_origin_pz_q <= (joint_origin_pz_q & ~wr_mask[LEN_W-1:0]) | wr_ones[LEN_W-1:0];
-            end
-            4'h8: begin
-              joint_axis_x_q <= (joint_axis_x_q & ~wr_mask[QUAT_W-1:0]) | wr_ones[QUAT_W-1:0];
-            end
-            4'h9: begin
-              joint_axis_y_q <= (joint_axis_y_q & ~wr_mask[QUAT_W-1:0]) | wr_ones[QUAT_W-1:0];
-            end
-            4'hA: begin
-              joint_axis_z_q <= (joint_axis_z_q & ~wr_mask[QUAT_W-1:0]) | wr_ones[QUAT_W-1:0];
-            end
-            4'hB: begin
-              joint_scale_q <= (joint_scale_q & ~wr_mask[SCALE_W-1:0]) | wr_ones[SCALE_W-1:0];
-            end
-            4'hC: begin
-              joint_lower_q <= (joint_lower_q & ~wr_mask[ANGLE_W-1:0]) | wr_ones[ANGLE_W-1:0];
-            end
-            4'hD: begin
-              joint_upper_q <= (joint_upper_q & ~wr_mask[ANGLE_W-1:0]) | wr_ones[ANGLE_W-1:0];
-            end
-            4'hE: begin
-              joint_vmax_q <= (joint_vmax_q & ~wr_mask[QD_W-1:0]) | wr_ones[QD_W-1:0];
-            end
-            4'hF: begin
-              joint_mu_q <= (joint_mu_q & ~wr_mask[MU_W-1:0]) | wr_ones[MU_W-1:0];
-            end
-            default: ;
-          endcase
+          if (wr_jword[0]) begin
+            if (w_strb[0]) joint_jcfg_prismatic_q <= w_data[0];
+            if (w_strb[0]) joint_jcfg_limited_q <= w_data[1];
+            if (w_strb[0]) joint_jcfg_vlimited_q <= w_data[2];
+          end
+          if (wr_jword[1]) begin
+            for (jb = 0; jb < QUAT_W; jb = jb + 1) if (w_strb[(0 + jb) / 8]) joint_origin_qw_q[jb] <= w_data[0 + jb];
+          end
+          if (wr_jword[2]) begin
+            for (jb = 0; jb < QUAT_W; jb = jb + 1) if (w_strb[(0 + jb) / 8]) joint_origin_qx_q[jb] <= w_data[0 + jb];
+          end
+          if (wr_jword[3]) begin
+            for (jb = 0; jb < QUAT_W; jb = jb + 1) if (w_strb[(0 + jb) / 8]) joint_origin_qy_q[jb] <= w_data[0 + jb];
+          end
+          if (wr_jword[4]) begin
+            for (jb = 0; jb < QUAT_W; jb = jb + 1) if (w_strb[(0 + jb) / 8]) joint_origin_qz_q[jb] <= w_data[0 + jb];
+          end
+          if (wr_jword[5]) begin
+            for (jb = 0; jb < LEN_W; jb = jb + 1) if (w_strb[(0 + jb) / 8]) joint_origin_px_q[jb] <= w_data[0 + jb];
+          end
+          if (wr_jword[6]) begin
+            for (jb = 0; jb < LEN_W; jb = jb + 1) if (w_strb[(0 + jb) / 8]) joint_origin_py_q[jb] <= w_data[0 + jb];
+          end
+          if (wr_jword[7]) begin
+            for (jb = 0; jb < LEN_W; jb = jb + 1) if (w_strb[(0 + jb) / 8]) joint_origin_pz_q[jb] <= w_data[0 + jb];
+          end
+          if (wr_jword[8]) begin
+            for (jb = 0; jb < QUAT_W; jb = jb + 1) if (w_strb[(0 + jb) / 8]) joint_axis_x_q[jb] <= w_data[0 + jb];
+          end
+          if (wr_jword[9]) begin
+            for (jb = 0; jb < QUAT_W; jb = jb + 1) if (w_strb[(0 + jb) / 8]) joint_axis_y_q[jb] <= w_data[0 + jb];
+          end
+          if (wr_jword[10]) begin
+            for (jb = 0; jb < QUAT_W; jb = jb + 1) if (w_strb[(0 + jb) / 8]) joint_axis_z_q[jb] <= w_data[0 + jb];
+          end
+          if (wr_jword[11]) begin
+            for (jb = 0; jb < SCALE_W; jb = jb + 1) if (w_strb[(0 + jb) / 8]) joint_scale_q[jb] <= w_data[0 + jb];
+          end
+          if (wr_jword[12]) begin
+            for (jb = 0; jb < ANGLE_W; jb = jb + 1) if (w_strb[(0 + jb) / 8]) joint_lower_q[jb] <= w_data[0 + jb];
+          end
+          if (wr_jword[13]) begin
+            for (jb = 0; jb < ANGLE_W; jb = jb + 1) if (w_strb[(0 + jb) / 8]) joint_upper_q[jb] <= w_data[0 + jb];
+          end
+          if (wr_jword[14]) begin
+            for (jb = 0; jb < QD_W; jb = jb + 1) if (w_strb[(0 + jb) / 8]) joint_vmax_q[jb] <= w_data[0 + jb];
+          end
+          if (wr_jword[15]) begin
+            for (jb = 0; jb < MU_W; jb = jb + 1) if (w_strb[(0 + jb) / 8]) joint_mu_q[jb] <= w_data[0 + jb];
+          end
         end
       end
 
-      // Fixed-point values sign-extended to the 32-bit read word
-      wire [31:0] sx_joint_origin_qw;
-      if (QUAT_W < 32) begin : g_sx_joint_origin_qw
-        assign sx_joint_origin_qw = {{(32-QUAT_W){joint_origin_qw_q[QUAT_W-1]}}, joint_origin_qw_q};
-      end else begin : g_nx_joint_origin_qw
-        assign sx_joint_origin_qw = joint_origin_qw_q;
-      end
-      wire [31:0] sx_joint_origin_qx;
-      if (QUAT_W < 32) begin : g_sx_joint_origin_qx
-        assign sx_joint_origin_qx = {{(32-QUAT_W){joint_origin_qx_q[QUAT_W-1]}}, joint_origin_qx_q};
-      end else begin : g_nx_joint_origin_qx
-        assign sx_joint_origin_qx = joint_origin_qx_q;
-      end
-      wire [31:0] sx_joint_origin_qy;
-      if (QUAT_W < 32) begin : g_sx_joint_origin_qy
-        assign sx_joint_origin_qy = {{(32-QUAT_W){joint_origin_qy_q[QUAT_W-1]}}, joint_origin_qy_q};
-      end else begin : g_nx_joint_origin_qy
-        assign sx_joint_origin_qy = joint_origin_qy_q;
-      end
-      wire [31:0] sx_joint_origin_qz;
-      if (QUAT_W < 32) begin : g_sx_joint_origin_qz
-        assign sx_joint_origin_qz = {{(32-QUAT_W){joint_origin_qz_q[QUAT_W-1]}}, joint_origin_qz_q};
-      end else begin : g_nx_joint_origin_qz
-        assign sx_joint_origin_qz = joint_origin_qz_q;
-      end
-      wire [31:0] sx_joint_origin_px;
-      if (LEN_W < 32) begin : g_sx_joint_origin_px
-        assign sx_joint_origin_px = {{(32-LEN_W){joint_origin_px_q[LEN_W-1]}}, joint_origin_px_q};
-      end else begin : g_nx_joint_origin_px
-        assign sx_joint_origin_px = joint_origin_px_q;
-      end
-      wire [31:0] sx_joint_origin_py;
-      if (LEN_W < 32) begin : g_sx_joint_origin_py
-        assign sx_joint_origin_py = {{(32-LEN_W){joint_origin_py_q[LEN_W-1]}}, joint_origin_py_q};
-      end else begin : g_nx_joint_origin_py
-        assign sx_joint_origin_py = joint_origin_py_q;
-      end
-      wire [31:0] sx_joint_origin_pz;
-      if (LEN_W < 32) begin : g_sx_joint_origin_pz
-        assign sx_joint_origin_pz = {{(32-LEN_W){joint_origin_pz_q[LEN_W-1]}}, joint_origin_pz_q};
-      end else begin : g_nx_joint_origin_pz
-        assign sx_joint_origin_pz = joint_origin_pz_q;
-      end
-      wire [31:0] sx_joint_axis_x;
-      if (QUAT_W < 32) begin : g_sx_joint_axis_x
-        assign sx_joint_axis_x = {{(32-QUAT_W){joint_axis_x_q[QUAT_W-1]}}, joint_axis_x_q};
-      end else begin : g_nx_joint_axis_x
-        assign sx_joint_axis_x = joint_axis_x_q;
-      end
-      wire [31:0] sx_joint_axis_y;
-      if (QUAT_W < 32) begin : g_sx_joint_axis_y
-        assign sx_joint_axis_y = {{(32-QUAT_W){joint_axis_y_q[QUAT_W-1]}}, joint_axis_y_q};
-      end else begin : g_nx_joint_axis_y
-        assign sx_joint_axis_y = joint_axis_y_q;
-      end
-      wire [31:0] sx_joint_axis_z;
-      if (QUAT_W < 32) begin : g_sx_joint_axis_z
-        assign sx_joint_axis_z = {{(32-QUAT_W){joint_axis_z_q[QUAT_W-1]}}, joint_axis_z_q};
-      end else begin : g_nx_joint_axis_z
-        assign sx_joint_axis_z = joint_axis_z_q;
-      end
-      wire [31:0] sx_joint_scale;
-      if (SCALE_W < 32) begin : g_sx_joint_scale
-        assign sx_joint_scale = {{(32-SCALE_W){joint_scale_q[SCALE_W-1]}}, joint_scale_q};
-      end else begin : g_nx_joint_scale
-        assign sx_joint_scale = joint_scale_q;
-      end
-      wire [31:0] sx_joint_lower;
-      if (ANGLE_W < 32) begin : g_sx_joint_lower
-        assign sx_joint_lower = {{(32-ANGLE_W){joint_lower_q[ANGLE_W-1]}}, joint_lower_q};
-      end else begin : g_nx_joint_lower
-        assign sx_joint_lower = joint_lower_q;
-      end
-      wire [31:0] sx_joint_upper;
-      if (ANGLE_W < 32) begin : g_sx_joint_upper
-        assign sx_joint_upper = {{(32-ANGLE_W){joint_upper_q[ANGLE_W-1]}}, joint_upper_q};
-      end else begin : g_nx_joint_upper
-        assign sx_joint_upper = joint_upper_q;
-      end
-      wire [31:0] sx_joint_vmax;
-      if (QD_W < 32) begin : g_sx_joint_vmax
-        assign sx_joint_vmax = {{(32-QD_W){joint_vmax_q[QD_W-1]}}, joint_vmax_q};
-      end else begin : g_nx_joint_vmax
-        assign sx_joint_vmax = joint_vmax_q;
-      end
-      wire [31:0] sx_joint_mu;
-      if (MU_W < 32) begin : g_sx_joint_mu
-        assign sx_joint_mu = {{(32-MU_W){joint_mu_q[MU_W-1]}}, joint_mu_q};
-      end else begin : g_nx_joint_mu
-        assign sx_joint_mu = joint_mu_q;
-      end
-
-      // Core-side outputs
+      // Core-side outputs and the joint's stored fields for the read multiplexer
       assign out_joint_jcfg_prismatic[j] = joint_jcfg_prismatic_q;
+      assign jnt_vec[j*JV_W + JO_JCFG_PRISMATIC +: 1] = joint_jcfg_prismatic_q;
       assign out_joint_jcfg_limited[j] = joint_jcfg_limited_q;
+      assign jnt_vec[j*JV_W + JO_JCFG_LIMITED +: 1] = joint_jcfg_limited_q;
       assign out_joint_jcfg_vlimited[j] = joint_jcfg_vlimited_q;
+      assign jnt_vec[j*JV_W + JO_JCFG_VLIMITED +: 1] = joint_jcfg_vlimited_q;
       assign out_joint_origin_qw[j*QUAT_W +: QUAT_W] = joint_origin_qw_q;
+      assign jnt_vec[j*JV_W + JO_ORIGIN_QW +: QUAT_W] = joint_origin_qw_q;
       assign out_joint_origin_qx[j*QUAT_W +: QUAT_W] = joint_origin_qx_q;
+      assign jnt_vec[j*JV_W + JO_ORIGIN_QX +: QUAT_W] = joint_origin_qx_q;
       assign out_joint_origin_qy[j*QUAT_W +: QUAT_W] = joint_origin_qy_q;
+      assign jnt_vec[j*JV_W + JO_ORIGIN_QY +: QUAT_W] = joint_origin_qy_q;
       assign out_joint_origin_qz[j*QUAT_W +: QUAT_W] = joint_origin_qz_q;
+      assign jnt_vec[j*JV_W + JO_ORIGIN_QZ +: QUAT_W] = joint_origin_qz_q;
       assign out_joint_origin_px[j*LEN_W +: LEN_W] = joint_origin_px_q;
+      assign jnt_vec[j*JV_W + JO_ORIGIN_PX +: LEN_W] = joint_origin_px_q;
       assign out_joint_origin_py[j*LEN_W +: LEN_W] = joint_origin_py_q;
+      assign jnt_vec[j*JV_W + JO_ORIGIN_PY +: LEN_W] = joint_origin_py_q;
       assign out_joint_origin_pz[j*LEN_W +: LEN_W] = joint_origin_pz_q;
+      assign jnt_vec[j*JV_W + JO_ORIGIN_PZ +: LEN_W] = joint_origin_pz_q;
       assign out_joint_axis_x[j*QUAT_W +: QUAT_W] = joint_axis_x_q;
+      assign jnt_vec[j*JV_W + JO_AXIS_X +: QUAT_W] = joint_axis_x_q;
       assign out_joint_axis_y[j*QUAT_W +: QUAT_W] = joint_axis_y_q;
+      assign jnt_vec[j*JV_W + JO_AXIS_Y +: QUAT_W] = joint_axis_y_q;
       assign out_joint_axis_z[j*QUAT_W +: QUAT_W] = joint_axis_z_q;
+      assign jnt_vec[j*JV_W + JO_AXIS_Z +: QUAT_W] = joint_axis_z_q;
       assign out_joint_scale[j*SCALE_W +: SCALE_W] = joint_scale_q;
+      assign jnt_vec[j*JV_W + JO_SCALE +: SCALE_W] = joint_scale_q;
       assign out_joint_lower[j*ANGLE_W +: ANGLE_W] = joint_lower_q;
+      assign jnt_vec[j*JV_W + JO_LOWER +: ANGLE_W] = joint_lower_q;
       assign out_joint_upper[j*ANGLE_W +: ANGLE_W] = joint_upper_q;
+      assign jnt_vec[j*JV_W + JO_UPPER +: ANGLE_W] = joint_upper_q;
       assign out_joint_vmax[j*QD_W +: QD_W] = joint_vmax_q;
+      assign jnt_vec[j*JV_W + JO_VMAX +: QD_W] = joint_vmax_q;
       assign out_joint_mu[j*MU_W +: MU_W] = joint_mu_q;
-
-      // Read word
-      reg [31:0] rd;
-      always @* begin
-        case (ar_word[3:0])
-          4'h0: rd = {29'd0, joint_jcfg_vlimited_q, joint_jcfg_limited_q,
-      joint_jcfg_prismatic_q};
-          4'h1: rd = sx_joint_origin_qw;
-          4'h2: rd = sx_joint_origin_qx;
-          4'h3: rd = sx_joint_origin_qy;
-          4'h4: rd = sx_joint_origin_qz;
-          4'h5: rd = sx_joint_origin_px;
-          4'h6: rd = sx_joint_origin_py;
-          4'h7: rd = sx_joint_origin_pz;
-          4'h8: rd = sx_joint_axis_x;
-          4'h9: rd = sx_joint_axis_y;
-          4'hA: rd = sx_joint_axis_z;
-          4'hB: rd = sx_joint_scale;
-          4'hC: rd = sx_joint_lower;
-          4'hD: rd = sx_joint_upper;
-          4'hE: rd = sx_joint_vmax;
-          4'hF: rd = sx_joint_mu;
-        endcase
-      end
-      assign rd_jnt_words[j*32 +: 32] = rd & {32{rd_jidx == JI}};
+      assign jnt_vec[j*JV_W + JO_MU +: MU_W] = joint_mu_q;
     end
   endgenerate
+
+  // Read word of the addressed joint: the joint's stored fields (one NMAX:1 multiplexer tree,
+  // ts_sel), then the word, then the sign extension.  Selecting the joint first on the stored
+  // bits costs about a fifth of selecting every joint's sign-extended word (ECP5 LUT4).
+  wire [JV_W-1:0] rj;
+  ts_sel #(.W(JV_W), .N(NMAX), .IW(6)) u_rd_joint (.in_vec(jnt_vec), .in_idx(rd_jidx), .out_el(rj));
+  wire rj_jcfg_prismatic = rj[JO_JCFG_PRISMATIC +: 1];
+  wire rj_jcfg_limited = rj[JO_JCFG_LIMITED +: 1];
+  wire rj_jcfg_vlimited = rj[JO_JCFG_VLIMITED +: 1];
+  wire [QUAT_W-1:0] rj_origin_qw = rj[JO_ORIGIN_QW +: QUAT_W];
+  wire [QUAT_W-1:0] rj_origin_qx = rj[JO_ORIGIN_QX +: QUAT_W];
+  wire [QUAT_W-1:0] rj_origin_qy = rj[JO_ORIGIN_QY +: QUAT_W];
+  wire [QUAT_W-1:0] rj_origin_qz = rj[JO_ORIGIN_QZ +: QUAT_W];
+  wire [LEN_W-1:0] rj_origin_px = rj[JO_ORIGIN_PX +: LEN_W];
+  wire [LEN_W-1:0] rj_origin_py = rj[JO_ORIGIN_PY +: LEN_W];
+  wire [LEN_W-1:0] rj_origin_pz = rj[JO_ORIGIN_PZ +: LEN_W];
+  wire [QUAT_W-1:0] rj_axis_x = rj[JO_AXIS_X +: QUAT_W];
+  wire [QUAT_W-1:0] rj_axis_y = rj[JO_AXIS_Y +: QUAT_W];
+  wire [QUAT_W-1:0] rj_axis_z = rj[JO_AXIS_Z +: QUAT_W];
+  wire [SCALE_W-1:0] rj_scale = rj[JO_SCALE +: SCALE_W];
+  wire [ANGLE_W-1:0] rj_lower = rj[JO_LOWER +: ANGLE_W];
+  wire [ANGLE_W-1:0] rj_upper = rj[JO_UPPER +: ANGLE_W];
+  wire [QD_W-1:0] rj_vmax = rj[JO_VMAX +: QD_W];
+  wire [MU_W-1:0] rj_mu = rj[JO_MU +: MU_W];
+  // Fixed-point values sign-extended to the 32-bit read word
+  generate
+    wire [31:0] sx_rj_origin_qw;
+    if (QUAT_W < 32) begin : g_sx_rj_origin_qw
+      assign sx_rj_origin_qw = {{(32-QUAT_W){rj_origin_qw[QUAT_W-1]}}, rj_origin_qw};
+    end else begin : g_nx_rj_origin_qw
+      assign sx_rj_origin_qw = rj_origin_qw;
+    end
+    wire [31:0] sx_rj_origin_qx;
+    if (QUAT_W < 32) begin : g_sx_rj_origin_qx
+      assign sx_rj_origin_qx = {{(32-QUAT_W){rj_origin_qx[QUAT_W-1]}}, rj_origin_qx};
+    end else begin : g_nx_rj_origin_qx
+      assign sx_rj_origin_qx = rj_origin_qx;
+    end
+    wire [31:0] sx_rj_origin_qy;
+    if (QUAT_W < 32) begin : g_sx_rj_origin_qy
+      assign sx_rj_origin_qy = {{(32-QUAT_W){rj_origin_qy[QUAT_W-1]}}, rj_origin_qy};
+    end else begin : g_nx_rj_origin_qy
+      assign sx_rj_origin_qy = rj_origin_qy;
+    end
+    wire [31:0] sx_rj_origin_qz;
+    if (QUAT_W < 32) begin : g_sx_rj_origin_qz
+      assign sx_rj_origin_qz = {{(32-QUAT_W){rj_origin_qz[QUAT_W-1]}}, rj_origin_qz};
+    end else begin : g_nx_rj_origin_qz
+      assign sx_rj_origin_qz = rj_origin_qz;
+    end
+    wire [31:0] sx_rj_origin_px;
+    if (LEN_W < 32) begin : g_sx_rj_origin_px
+      assign sx_rj_origin_px = {{(32-LEN_W){rj_origin_px[LEN_W-1]}}, rj_origin_px};
+    end else begin : g_nx_rj_origin_px
+      assign sx_rj_origin_px = rj_origin_px;
+    end
+    wire [31:0] sx_rj_origin_py;
+    if (LEN_W < 32) begin : g_sx_rj_origin_py
+      assign sx_rj_origin_py = {{(32-LEN_W){rj_origin_py[LEN_W-1]}}, rj_origin_py};
+    end else begin : g_nx_rj_origin_py
+      assign sx_rj_origin_py = rj_origin_py;
+    end
+    wire [31:0] sx_rj_origin_pz;
+    if (LEN_W < 32) begin : g_sx_rj_origin_pz
+      assign sx_rj_origin_pz = {{(32-LEN_W){rj_origin_pz[LEN_W-1]}}, rj_origin_pz};
+    end else begin : g_nx_rj_origin_pz
+      assign sx_rj_origin_pz = rj_origin_pz;
+    end
+    wire [31:0] sx_rj_axis_x;
+    if (QUAT_W < 32) begin : g_sx_rj_axis_x
+      assign sx_rj_axis_x = {{(32-QUAT_W){rj_axis_x[QUAT_W-1]}}, rj_axis_x};
+    end else begin : g_nx_rj_axis_x
+      assign sx_rj_axis_x = rj_axis_x;
+    end
+    wire [31:0] sx_rj_axis_y;
+    if (QUAT_W < 32) begin : g_sx_rj_axis_y
+      assign sx_rj_axis_y = {{(32-QUAT_W){rj_axis_y[QUAT_W-1]}}, rj_axis_y};
+    end else begin : g_nx_rj_axis_y
+      assign sx_rj_axis_y = rj_axis_y;
+    end
+    wire [31:0] sx_rj_axis_z;
+    if (QUAT_W < 32) begin : g_sx_rj_axis_z
+      assign sx_rj_axis_z = {{(32-QUAT_W){rj_axis_z[QUAT_W-1]}}, rj_axis_z};
+    end else begin : g_nx_rj_axis_z
+      assign sx_rj_axis_z = rj_axis_z;
+    end
+    wire [31:0] sx_rj_scale;
+    if (SCALE_W < 32) begin : g_sx_rj_scale
+      assign sx_rj_scale = {{(32-SCALE_W){rj_scale[SCALE_W-1]}}, rj_scale};
+    end else begin : g_nx_rj_scale
+      assign sx_rj_scale = rj_scale;
+    end
+    wire [31:0] sx_rj_lower;
+    if (ANGLE_W < 32) begin : g_sx_rj_lower
+      assign sx_rj_lower = {{(32-ANGLE_W){rj_lower[ANGLE_W-1]}}, rj_lower};
+    end else begin : g_nx_rj_lower
+      assign sx_rj_lower = rj_lower;
+    end
+    wire [31:0] sx_rj_upper;
+    if (ANGLE_W < 32) begin : g_sx_rj_upper
+      assign sx_rj_upper = {{(32-ANGLE_W){rj_upper[ANGLE_W-1]}}, rj_upper};
+    end else begin : g_nx_rj_upper
+      assign sx_rj_upper = rj_upper;
+    end
+    wire [31:0] sx_rj_vmax;
+    if (QD_W < 32) begin : g_sx_rj_vmax
+      assign sx_rj_vmax = {{(32-QD_W){rj_vmax[QD_W-1]}}, rj_vmax};
+    end else begin : g_nx_rj_vmax
+      assign sx_rj_vmax = rj_vmax;
+    end
+    wire [31:0] sx_rj_mu;
+    if (MU_W < 32) begin : g_sx_rj_mu
+      assign sx_rj_mu = {{(32-MU_W){rj_mu[MU_W-1]}}, rj_mu};
+    end else begin : g_nx_rj_mu
+      assign sx_rj_mu = rj_mu;
+    end
+  endgenerate
+
+  reg  [31:0] rd_jnt_data;
+  always @* begin
+    case (ar_word[3:0])
+      4'h0: rd_jnt_data = {29'd0, rj_jcfg_vlimited, rj_jcfg_limited, rj_jcfg_prismatic};
+      4'h1: rd_jnt_data = sx_rj_origin_qw;
+      4'h2: rd_jnt_data = sx_rj_origin_qx;
+      4'h3: rd_jnt_data = sx_rj_origin_qy;
+      4'h4: rd_jnt_data = sx_rj_origin_qz;
+      4'h5: rd_jnt_data = sx_rj_origin_px;
+      4'h6: rd_jnt_data = sx_rj_origin_py;
+      4'h7: rd_jnt_data = sx_rj_origin_pz;
+      4'h8: rd_jnt_data = sx_rj_axis_x;
+      4'h9: rd_jnt_data = sx_rj_axis_y;
+      4'hA: rd_jnt_data = sx_rj_axis_z;
+      4'hB: rd_jnt_data = sx_rj_scale;
+      4'hC: rd_jnt_data = sx_rj_lower;
+      4'hD: rd_jnt_data = sx_rj_upper;
+      4'hE: rd_jnt_data = sx_rj_vmax;
+      4'hF: rd_jnt_data = sx_rj_mu;
+    endcase
+  end
 
   // ---- read mux and response -----------------------------------------------------------
   reg  [31:0] rd_glb_data;

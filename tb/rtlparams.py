@@ -212,7 +212,7 @@ DEPS["ts_core_commit"] = ["ts_mul", "ts_resize", "ts_delay", "ts_ecp5_mult18", "
 DEPS["ts_core_solve"] = ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat", "ts_ecp5_mult18"]
 DEPS["ts_core_law"] = ["ts_quat_mul", "ts_quat_rotate", "ts_mul_bank", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"]
 DEPS["ts_servo_core"] = ["ts_servo_regs", "ts_core_commit", "ts_core_fk", "ts_core_law", "ts_core_solve", "ts_sel"]
-DEPS["ts_servo_regs"] = []
+DEPS["ts_servo_regs"] = ["ts_sel"]
 #: the datapath modules (documented, synthesised); the others are shared pieces
 PRIMITIVES = ("ts_quat_mul", "ts_quat_rotate", "ts_sincos", "ts_joint_quat", "ts_screw_transport")
 SHARED = ("ts_round_sat", "ts_mul", "ts_delay", "ts_resize")
@@ -336,7 +336,7 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
     # the generated register block (rtl/ts_servo_regs.rdl): joint counts at the extremes, both configurations
     for nmax in (1, 8, 60):
         for config in (0, 1):
-            jobs.append(("ts_servo_regs", [str(RTL / "ts_servo_regs.v")], {"NMAX": nmax, "CONFIG": config}))
+            jobs.append(("ts_servo_regs", sources("ts_servo_regs"), {"NMAX": nmax, "CONFIG": config}))
     # the FK/Jacobian engine (rtl/ts_core_fk.v): both configurations and multiplier targets
     for config in (0, 1):
         for target in TARGETS:

@@ -21,6 +21,8 @@ import tsbench
 ROOT = tsbench.ROOT
 RDL = ROOT / "rtl" / "ts_servo_regs.rdl"
 VFILE = ROOT / "rtl" / "ts_servo_regs.v"
+#: the joint read multiplexer the register block instantiates
+SEL = ROOT / "rtl" / "ts_sel.v"
 HEADER = ROOT / "rtl" / "generated" / "ts_servo_regs.h"
 
 
@@ -214,11 +216,13 @@ def test_html_docs(tmp_path):
 @pytest.mark.parametrize("nmax,config", [(1, 0), (8, 0), (8, 1), (60, 1)])
 def test_verilog_lint(nmax, config):
     """verilator --lint-only -Wall clean; Icarus (-g2005) compiles."""
-    r = subprocess.run(["verilator", "--lint-only", "-Wall", f"-GNMAX={nmax}", f"-GCONFIG={config}", str(VFILE)],
+    r = subprocess.run(["verilator", "--lint-only", "-Wall", "--top-module", "ts_servo_regs", f"-GNMAX={nmax}",
+                        f"-GCONFIG={config}", str(VFILE), str(SEL)],
                        capture_output=True, text=True)
     assert r.returncode == 0 and not r.stderr.strip(), r.stderr
-    r = subprocess.run(["iverilog", "-g2005", "-Wall", f"-Pts_servo_regs.NMAX={nmax}",
-                        f"-Pts_servo_regs.CONFIG={config}", "-o", "/dev/null", str(VFILE)], capture_output=True, text=True)
+    r = subprocess.run(["iverilog", "-g2005", "-Wall", "-s", "ts_servo_regs", f"-Pts_servo_regs.NMAX={nmax}",
+                        f"-Pts_servo_regs.CONFIG={config}", "-o", "/dev/null", str(VFILE), str(SEL)],
+                       capture_output=True, text=True)
     assert r.returncode == 0 and not r.stderr.strip(), r.stderr
 
 
@@ -228,7 +232,7 @@ def test_verilog_parameter_check(params, ok, tmp_path):
     """The module stops the simulation with an ERROR line on parameters outside its range."""
     args = [f"-Pts_servo_regs.{k}={v}" for k, v in params.items()]
     exe = tmp_path / "sim.vvp"
-    subprocess.run(["iverilog", "-g2005", "-s", "ts_servo_regs", *args, "-o", str(exe), str(VFILE)], check=True,
+    subprocess.run(["iverilog", "-g2005", "-s", "ts_servo_regs", *args, "-o", str(exe), str(VFILE), str(SEL)], check=True,
                    capture_output=True)
     out = subprocess.run(["vvp", "-n", str(exe)], capture_output=True, text=True, timeout=60).stdout
     assert ("ERROR" in out) != ok, out

@@ -13,6 +13,7 @@ import random
 
 import pytest
 
+import rtlparams
 import tsbench
 
 MODULE = "ts_servo_regs"
@@ -545,7 +546,7 @@ if cocotb is not None:
 
 # ---- pytest ---------------------------------------------------------------------------------------
 def sources(sim: str) -> list[str]:
-    src = [str(tsbench.RTL / "ts_servo_regs.v")]
+    src = rtlparams.sources(MODULE)
     if sim == "verilator":
         # run_bench makes clk, rst, in_* and out_* visible to cocotb; the AXI ports too:
         src.append(str(tsbench.TB / MODULE / "public.vlt"))
