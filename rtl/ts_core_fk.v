@@ -161,20 +161,16 @@ module ts_core_fk #(
   genvar gi;
   integer k;
 
-  // ---- configuration registers ----------------------------------------------------------------
-  // Vectors use 4 slots per joint (index {joint, component}); slot 3 of a 3-vector is unused.
-  reg signed [Q_W-1:0]  c_qo [0:4*AD-1];
-  reg signed [LN_W-1:0] c_po [0:4*AD-1];
-  reg signed [Q_W-1:0]  c_ax [0:4*AD-1];
-  reg signed [S_W-1:0]  c_s  [0:AD-1];
-  reg signed [KT_W-1:0] c_k  [0:AD-1];
+  // ---- configuration ---------------------------------------------------------------------------
+  // Per joint: memories without reset (ts_ram, one per vector component; distributed RAM on ECP5),
+  // read at the joint of the step (ji), of the joint-quaternion stream (pre_j) or of the screw
+  // transport (st_j).  The loader writes every joint's words at a commit, before any start.
   reg        [AD-1:0]   c_pr;
   reg signed [Q_W-1:0]  c_qb [0:3];
   reg signed [LN_W-1:0] c_pb [0:3];
   reg signed [Q_W-1:0]  c_qt [0:3];
   reg signed [LN_W-1:0] c_pt [0:3];
   reg        [JI_W:0]   c_n;
-  reg signed [ANG_W-1:0] c_q [0:AD-1];
 
   wire [3:0]      cf = in_cfg_addr[3:0];
   wire [JI_W-1:0] cj = in_cfg_addr[JI_W+3:4];
@@ -184,38 +180,48 @@ module ts_core_fk #(
   wire cfg_wr = in_cfg_we && !out_busy;
   wire q_wr = in_q_we && !out_busy;
 
-  // Per-joint registers, one block per entry (the lint tool does not unroll a reset loop over
-  // the whole array at large NMAX).
+  wire cfg_jw = cfg_wr && !cg;
+  // joint step (ji), joint-quaternion stream (pre_j) and screw transport (st_j) joints, below
+  wire [JI_W-1:0] ji_a, pre_j, st_j_a;
+  // origin quaternion and position, components of joint ji
+  wire signed [Q_W-1:0]  qo_j [0:3];
+  wire signed [LN_W-1:0] po_j [0:2];
+  // axis of joint pre_j and of joint st_j
+  wire signed [Q_W-1:0]  ax_pre [0:2];
+  wire signed [Q_W-1:0]  ax_st [0:2];
+  // scale of joint pre_j and st_j, kturn and q of joint pre_j
+  wire signed [S_W-1:0]  s_pre, s_st;
+  wire signed [KT_W-1:0] k_pre;
+  wire signed [ANG_W-1:0] q_pre;
   generate
-    for (gi = 0; gi < AD; gi = gi + 1) begin : g_jcfg
-      localparam [JI_W-1:0] J = gi;
-      always @(posedge clk) begin
-        if (rst) begin
-          for (k = 0; k < 4; k = k + 1) begin
-            c_qo[4*gi+k] <= {Q_W{1'b0}};
-            c_po[4*gi+k] <= {LN_W{1'b0}};
-            c_ax[4*gi+k] <= {Q_W{1'b0}};
-          end
-          c_s[gi] <= {S_W{1'b0}};
-          c_k[gi] <= {KT_W{1'b0}};
-          c_pr[gi] <= 1'b0;
-          c_q[gi] <= {ANG_W{1'b0}};
-        end else begin
-          if (cfg_wr && !cg && (cj == J)) begin
-            for (k = 0; k < 4; k = k + 1) begin
-              if ((cf[3:2] == 2'd0) && (cf[1:0] == k[1:0])) c_qo[4*gi+k] <= in_cfg_data[Q_W-1:0];
-              if ((cf[3:2] == 2'd1) && (cf[1:0] == k[1:0])) c_po[4*gi+k] <= in_cfg_data[LN_W-1:0];
-              if ((cf[3:2] == 2'd2) && (cf[1:0] == k[1:0])) c_ax[4*gi+k] <= in_cfg_data[Q_W-1:0];
-            end
-            if (cf == 4'd12) c_s[gi] <= in_cfg_data[S_W-1:0];
-            if (cf == 4'd13) c_k[gi] <= in_cfg_data[KT_W-1:0];
-            if (cf == 4'd14) c_pr[gi] <= in_cfg_data[0];
-          end
-          if (q_wr && (in_q_addr == J)) c_q[gi] <= in_q_data;
-        end
-      end
+    for (gi = 0; gi < 4; gi = gi + 1) begin : g_cqo
+      ts_ram #(.W(Q_W), .AW(JI_W), .R(1)) u_m (
+        .clk(clk), .in_we(cfg_jw && (cf == gi)), .in_waddr(cj), .in_wdata(in_cfg_data[Q_W-1:0]),
+        .in_raddr(ji_a), .out_rdata(qo_j[gi]));
+    end
+    for (gi = 0; gi < 3; gi = gi + 1) begin : g_cpo
+      ts_ram #(.W(LN_W), .AW(JI_W), .R(1)) u_m (
+        .clk(clk), .in_we(cfg_jw && (cf == 4 + gi)), .in_waddr(cj), .in_wdata(in_cfg_data[LN_W-1:0]),
+        .in_raddr(ji_a), .out_rdata(po_j[gi]));
+    end
+    for (gi = 0; gi < 3; gi = gi + 1) begin : g_cax
+      ts_ram #(.W(Q_W), .AW(JI_W), .R(2)) u_m (
+        .clk(clk), .in_we(cfg_jw && (cf == 8 + gi)), .in_waddr(cj), .in_wdata(in_cfg_data[Q_W-1:0]),
+        .in_raddr({st_j_a, pre_j}), .out_rdata({ax_st[gi], ax_pre[gi]}));
     end
   endgenerate
+  ts_ram #(.W(S_W), .AW(JI_W), .R(2)) u_cs (
+    .clk(clk), .in_we(cfg_jw && (cf == 4'd12)), .in_waddr(cj), .in_wdata(in_cfg_data[S_W-1:0]),
+    .in_raddr({st_j_a, pre_j}), .out_rdata({s_st, s_pre}));
+  ts_ram #(.W(KT_W), .AW(JI_W), .R(1)) u_ck (
+    .clk(clk), .in_we(cfg_jw && (cf == 4'd13)), .in_waddr(cj), .in_wdata(in_cfg_data[KT_W-1:0]),
+    .in_raddr(pre_j), .out_rdata(k_pre));
+  ts_ram #(.W(ANG_W), .AW(JI_W), .R(1)) u_cq (
+    .clk(clk), .in_we(q_wr), .in_waddr(in_q_addr), .in_wdata(in_q_data), .in_raddr(pre_j), .out_rdata(q_pre));
+  always @(posedge clk) begin
+    if (rst)                        c_pr <= {AD{1'b0}};
+    else if (cfg_jw && (cf == 4'd14)) c_pr[cj] <= in_cfg_data[0];
+  end
 
   // base, tool, joint count
   always @(posedge clk) begin
@@ -265,19 +271,18 @@ module ts_core_fk #(
   reg signed [P_W-1:0] pf [0:2];   // pF of the current joint
   reg signed [Q_W-1:0] zr [0:2];   // z of the current (prismatic) joint
 
-  // per-joint results
-  reg signed [Q_W-1:0]  r_jq [0:4*AD-1];   // joint quaternions
-  reg signed [L_W-1:0]  r_d  [0:AD-1];     // d = s q (prismatic)
-  reg signed [Q_W-1:0]  r_qf [0:4*AD-1];   // QF_i
-  reg signed [P_W-1:0]  r_p  [0:4*AD-1];   // p_i
-  reg signed [JW_W-1:0] r_w  [0:4*AD-1];   // J omega
-  reg signed [JV_W-1:0] r_v  [0:4*AD-1];   // J v
+  // per-joint results (ts_ram, written below): joint quaternion and d = s q of joint ji, QF_i and
+  // p_i of joint st_j
+  wire signed [Q_W-1:0] rjq_j [0:3];
+  wire signed [L_W-1:0] rd_j;
+  wire signed [Q_W-1:0] rqf_st [0:3];
+  wire signed [P_W-1:0] rp_st [0:2];
 
   wire [JI_W-1:0] n_m1 = c_n[JI_W-1:0] - {{(JI_W-1){1'b0}}, 1'b1};
 
   // ---- joint quaternions and prismatic displacements, streamed at start ----------------------------
   wire            pre_valid = (state != S_IDLE) && (state != S_DONE) && (pre_in < c_n);
-  wire [JI_W-1:0] pre_j = pre_in[JI_W-1:0];
+  assign pre_j = pre_in[JI_W-1:0];
   wire            jq_valid;
   wire signed [Q_W-1:0] jq_o [0:3];
   wire            jq_sat;
@@ -289,8 +294,8 @@ module ts_core_fk #(
     .TWOPI(TWOPI), .SIXTH_W(TS_SIXTH_W), .SIXTH_F(TS_SIXTH_F), .SIXTH(SIXTH), .ROM_FILE(ROM_FILE),
     .TARGET(TARGET)
   ) u_jq (
-    .clk(clk), .rst(rst), .in_valid(pre_valid), .in_angle(c_q[pre_j]), .in_kturn(c_k[pre_j]),
-    .in_axis_x(c_ax[{pre_j, 2'd0}]), .in_axis_y(c_ax[{pre_j, 2'd1}]), .in_axis_z(c_ax[{pre_j, 2'd2}]),
+    .clk(clk), .rst(rst), .in_valid(pre_valid), .in_angle(q_pre), .in_kturn(k_pre),
+    .in_axis_x(ax_pre[0]), .in_axis_y(ax_pre[1]), .in_axis_z(ax_pre[2]),
     .out_valid(jq_valid), .out_w(jq_o[0]), .out_x(jq_o[1]), .out_y(jq_o[2]), .out_z(jq_o[3]),
     .out_sat(jq_sat));
 
@@ -298,7 +303,7 @@ module ts_core_fk #(
   localparam MLD = ts_mul_lat(S_W, ANG_W);
   wire signed [S_W+ANG_W-1:0] d_p;
   ts_mul #(.A_W(S_W), .B_W(ANG_W), .TARGET(TARGET)) u_dm (
-    .clk(clk), .rst(rst), .a(c_s[pre_j]), .b(c_q[pre_j]), .p(d_p));
+    .clk(clk), .rst(rst), .a(s_pre), .b(q_pre), .p(d_p));
   wire signed [L_W-1:0] d_o;
   wire d_sat;
   ts_round_sat #(.IN_W(S_W+ANG_W), .SHIFT(S_F+A_F-L_F), .OUT_W(L_W), .SAT(1)) u_dr (
@@ -372,12 +377,12 @@ module ts_core_fk #(
   generate
     for (gi = 0; gi < 4; gi = gi + 1) begin : g_stq
       localparam [1:0] C = gi;
-      assign st_q[gi] = st_fk ? qf[gi] : r_qf[{st_j, C}];
+      assign st_q[gi] = st_fk ? qf[gi] : rqf_st[C];
     end
     for (gi = 0; gi < 3; gi = gi + 1) begin : g_stp
       localparam [1:0] C = gi;
       assign st_pref[gi] = st_fk ? {P_W{1'b0}} : tool_p[gi];
-      assign st_pi[gi] = st_fk ? {P_W{1'b0}} : r_p[{st_j, C}];
+      assign st_pi[gi] = st_fk ? {P_W{1'b0}} : rp_st[C];
     end
   endgenerate
   ts_screw_transport #(
@@ -387,8 +392,8 @@ module ts_core_fk #(
   ) u_st (
     .clk(clk), .rst(rst), .in_valid(st_valid),
     .in_q_w(st_q[0]), .in_q_x(st_q[1]), .in_q_y(st_q[2]), .in_q_z(st_q[3]),
-    .in_axis_x(c_ax[{st_j, 2'd0}]), .in_axis_y(c_ax[{st_j, 2'd1}]), .in_axis_z(c_ax[{st_j, 2'd2}]),
-    .in_prismatic(c_pr[st_j] | st_fk), .in_s(c_s[st_j]),
+    .in_axis_x(ax_st[0]), .in_axis_y(ax_st[1]), .in_axis_z(ax_st[2]),
+    .in_prismatic(c_pr[st_j] | st_fk), .in_s(s_st),
     .in_pref_x(st_pref[0]), .in_pref_y(st_pref[1]), .in_pref_z(st_pref[2]),
     .in_pi_x(st_pi[0]), .in_pi_y(st_pi[1]), .in_pi_z(st_pi[2]),
     .out_valid(st_ovalid), .out_z_x(st_z[0]), .out_z_y(st_z[1]), .out_z_z(st_z[2]),
@@ -406,7 +411,7 @@ module ts_core_fk #(
   ts_delay #(.W(1), .DEPTH(MLP+1+RL)) u_ppv (.clk(clk), .rst(rst), .din(pp_valid), .dout(pp_ovalid));
   wire [3*(L_W+Q_W)-1:0] pp_p;
   ts_mul_bank #(.N(3), .FOLD(FOLD), .A_W(L_W), .B_W(Q_W), .TARGET(TARGET)) u_mpp (
-    .clk(clk), .rst(rst), .in_valid(pp_valid), .in_a({r_d[ji], r_d[ji], r_d[ji]}), .in_b({zr[2], zr[1], zr[0]}),
+    .clk(clk), .rst(rst), .in_valid(pp_valid), .in_a({rd_j, rd_j, rd_j}), .in_b({zr[2], zr[1], zr[0]}),
     .out_p(pp_p));
   generate
     for (gi = 0; gi < 3; gi = gi + 1) begin : g_pp
@@ -531,9 +536,9 @@ module ts_core_fk #(
           ro_valid <= 1'b1;
           for (k = 0; k < 4; k = k + 1) begin
             qm_a[k] <= qc[k];
-            qm_b[k] <= tool ? c_qt[k] : c_qo[{ji, k[1:0]}];
+            qm_b[k] <= tool ? c_qt[k] : qo_j[k];
           end
-          for (k = 0; k < 3; k = k + 1) ro_v[k] <= tool ? c_pt[k] : c_po[{ji, k[1:0]}];
+          for (k = 0; k < 3; k = k + 1) ro_v[k] <= tool ? c_pt[k] : po_j[k];
           have_pf <= 1'b0;
           have_q2 <= 1'b0;
           state <= S_WAIT1;
@@ -560,7 +565,7 @@ module ts_core_fk #(
               qm_valid <= 1'b1;
               for (k = 0; k < 4; k = k + 1) begin
                 qm_a[k] <= qf[k];
-                qm_b[k] <= r_jq[{ji, k[1:0]}];
+                qm_b[k] <= rjq_j[k];
               end
               state <= S_WAIT2;
             end
@@ -640,42 +645,34 @@ module ts_core_fk #(
     end
   end
 
-  // ---- per-joint results, one block per entry -------------------------------------------------------
+  // ---- per-joint results -----------------------------------------------------------------------------
   // frame i stored at the end of its step: QF_i, and p_i (pF, or the prismatic origin)
   wire fr_we = ((state == S_WAIT2) && (have_q2 || qm_ovalid) && pf_now) || ((state == S_WAITP) && pp_ovalid);
   wire col_we = st_ovalid && ((state == S_JAC) || (state == S_JWAIT));
   wire [JI_W-1:0] col_j = col_out[JI_W-1:0];
-  generate
-    for (gi = 0; gi < AD; gi = gi + 1) begin : g_res
-      localparam [JI_W-1:0] J = gi;
-      always @(posedge clk) begin
-        if (rst) begin
-          for (k = 0; k < 4; k = k + 1) begin
-            r_jq[4*gi+k] <= {Q_W{1'b0}};
-            r_qf[4*gi+k] <= {Q_W{1'b0}};
-            r_p[4*gi+k] <= {P_W{1'b0}};
-            r_w[4*gi+k] <= {JW_W{1'b0}};
-            r_v[4*gi+k] <= {JV_W{1'b0}};
-          end
-          r_d[gi] <= {L_W{1'b0}};
-        end else begin
-          if (jq_valid && (jq_j == J))
-            for (k = 0; k < 4; k = k + 1) r_jq[4*gi+k] <= jq_o[k];
-          if (d_valid && (d_j == J)) r_d[gi] <= d_o;
-          if (fr_we && (ji == J)) begin
-            for (k = 0; k < 4; k = k + 1) r_qf[4*gi+k] <= qf[k];
-            for (k = 0; k < 3; k = k + 1) r_p[4*gi+k] <= (state == S_WAITP) ? pp_o[k] : pf_cur[k];
-          end
-          if (col_we && (col_j == J)) begin
-            for (k = 0; k < 3; k = k + 1) begin
-              r_w[4*gi+k] <= st_w[k];
-              r_v[4*gi+k] <= st_v[k];
-            end
-          end
-        end
-      end
-    end
-  endgenerate
+  assign ji_a = ji;
+  assign st_j_a = st_j;
+  wire [3*P_W-1:0] fr_p = (state == S_WAITP) ? {pp_o[2], pp_o[1], pp_o[0]} : {pf_cur[2], pf_cur[1], pf_cur[0]};
+  wire [3*JW_W-1:0] col_w;
+  wire [3*JV_W-1:0] col_v;
+  wire [3*P_W-1:0] col_p;
+  ts_ram #(.W(4*Q_W), .AW(JI_W), .R(1)) u_rjq (
+    .clk(clk), .in_we(jq_valid), .in_waddr(jq_j), .in_wdata({jq_o[3], jq_o[2], jq_o[1], jq_o[0]}),
+    .in_raddr(ji), .out_rdata({rjq_j[3], rjq_j[2], rjq_j[1], rjq_j[0]}));
+  ts_ram #(.W(L_W), .AW(JI_W), .R(1)) u_rd (
+    .clk(clk), .in_we(d_valid), .in_waddr(d_j), .in_wdata(d_o), .in_raddr(ji), .out_rdata(rd_j));
+  ts_ram #(.W(4*Q_W), .AW(JI_W), .R(1)) u_rqf (
+    .clk(clk), .in_we(fr_we), .in_waddr(ji), .in_wdata({qf[3], qf[2], qf[1], qf[0]}),
+    .in_raddr(st_j), .out_rdata({rqf_st[3], rqf_st[2], rqf_st[1], rqf_st[0]}));
+  ts_ram #(.W(3*P_W), .AW(JI_W), .R(2)) u_rp (
+    .clk(clk), .in_we(fr_we), .in_waddr(ji), .in_wdata(fr_p),
+    .in_raddr({in_col_addr, st_j}), .out_rdata({col_p, rp_st[2], rp_st[1], rp_st[0]}));
+  ts_ram #(.W(3*JW_W), .AW(JI_W), .R(1)) u_rw (
+    .clk(clk), .in_we(col_we), .in_waddr(col_j), .in_wdata({st_w[2], st_w[1], st_w[0]}),
+    .in_raddr(in_col_addr), .out_rdata(col_w));
+  ts_ram #(.W(3*JV_W), .AW(JI_W), .R(1)) u_rv (
+    .clk(clk), .in_we(col_we), .in_waddr(col_j), .in_wdata({st_v[2], st_v[1], st_v[0]}),
+    .in_raddr(in_col_addr), .out_rdata(col_v));
 
   // ---- column read port -----------------------------------------------------------------------------
   always @(posedge clk) begin
@@ -684,15 +681,9 @@ module ts_core_fk #(
       out_col_v_x <= {JV_W{1'b0}}; out_col_v_y <= {JV_W{1'b0}}; out_col_v_z <= {JV_W{1'b0}};
       out_col_p_x <= {P_W{1'b0}};  out_col_p_y <= {P_W{1'b0}};  out_col_p_z <= {P_W{1'b0}};
     end else begin
-      out_col_w_x <= r_w[{in_col_addr, 2'd0}];
-      out_col_w_y <= r_w[{in_col_addr, 2'd1}];
-      out_col_w_z <= r_w[{in_col_addr, 2'd2}];
-      out_col_v_x <= r_v[{in_col_addr, 2'd0}];
-      out_col_v_y <= r_v[{in_col_addr, 2'd1}];
-      out_col_v_z <= r_v[{in_col_addr, 2'd2}];
-      out_col_p_x <= r_p[{in_col_addr, 2'd0}];
-      out_col_p_y <= r_p[{in_col_addr, 2'd1}];
-      out_col_p_z <= r_p[{in_col_addr, 2'd2}];
+      {out_col_w_z, out_col_w_y, out_col_w_x} <= col_w;
+      {out_col_v_z, out_col_v_y, out_col_v_x} <= col_v;
+      {out_col_p_z, out_col_p_y, out_col_p_x} <= col_p;
     end
   end
 

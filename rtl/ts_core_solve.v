@@ -197,10 +197,8 @@ module ts_core_solve #(
 
   // ---- storage ---------------------------------------------------------------------------------
   // configuration
-  reg signed [ANG_W-1:0] cfg_lo    [0:NMAX-1];
-  reg signed [ANG_W-1:0] cfg_hi    [0:NMAX-1];
-  reg signed [QD_W-1:0]  cfg_vmax  [0:NMAX-1];
-  reg signed [MUW-1:0]   cfg_mu    [0:NMAX-1];
+  // (per joint, read at col: lower, upper, vmax and mu in ts_ram memories, below, as are q, the warm
+  // start and the state c, k and the bounds; every word a tick reads is written before)
   reg                    cfg_lim   [0:NMAX-1];
   reg signed [LCW-1:0]   cfg_L;
   reg signed [KLW-1:0]   cfg_klim;
@@ -210,17 +208,11 @@ module ts_core_solve #(
   // per-solve inputs: J rows (omega at {j, 0..2}, v at {j, 4..6}), q, warm start, V
   reg signed [JWW-1:0]   x_jw      [0:(4 << JI_W)-1];   // {joint, row}; not reset (RAM)
   reg signed [JVW-1:0]   x_jv      [0:(4 << JI_W)-1];
-  reg signed [ANG_W-1:0] x_q       [0:NMAX-1];
-  reg signed [QD_W-1:0]  x_warm    [0:NMAX-1];
   reg signed [VLW-1:0]   x_vw      [0:3];
   reg signed [VLW-1:0]   x_vv      [0:3];
   // solver state
   reg signed [JSW-1:0]   js        [0:(8 << JI_W)-1];   // {joint, row}; not reset (RAM)
   reg signed [TW_W-1:0]  vs        [0:5];
-  reg signed [STW-1:0]   cst       [0:NMAX-1];
-  reg signed [KW-1:0]    kst       [0:NMAX-1];
-  reg signed [QD_W-1:0]  blo       [0:NMAX-1];
-  reg signed [QD_W-1:0]  bhi       [0:NMAX-1];
   reg                    blo_pos   [0:NMAX-1];
   reg                    bhi_pos   [0:NMAX-1];
   reg signed [QD_W-1:0]  qd        [0:NMAX-1];
@@ -239,13 +231,7 @@ module ts_core_solve #(
 
   always @(posedge clk) begin
     if (rst) begin
-      for (ci = 0; ci < NMAX; ci = ci + 1) begin
-        cfg_lo[ci] <= {ANG_W{1'b0}};
-        cfg_hi[ci] <= {ANG_W{1'b0}};
-        cfg_vmax[ci] <= {QD_W{1'b0}};
-        cfg_mu[ci] <= {MUW{1'b0}};
-        cfg_lim[ci] <= 1'b0;
-      end
+      for (ci = 0; ci < NMAX; ci = ci + 1) cfg_lim[ci] <= 1'b0;
       cfg_L <= {LCW{1'b0}};
       cfg_klim <= {KLW{1'b0}};
       cfg_dt <= {DTW{1'b0}};
@@ -254,10 +240,6 @@ module ts_core_solve #(
     end else if (in_cfg_we) begin
       if (!cfg_g) begin
         case (cfg_f)
-          4'd0: cfg_lo[cfg_j] <= in_cfg_data[ANG_W-1:0];
-          4'd1: cfg_hi[cfg_j] <= in_cfg_data[ANG_W-1:0];
-          4'd2: cfg_vmax[cfg_j] <= in_cfg_data[QD_W-1:0];
-          4'd3: cfg_mu[cfg_j] <= in_cfg_data[MUW-1:0];
           4'd4: cfg_lim[cfg_j] <= in_cfg_data[0];
           default: ;
         endcase
@@ -276,10 +258,6 @@ module ts_core_solve #(
 
   always @(posedge clk) begin
     if (rst) begin
-      for (xi = 0; xi < NMAX; xi = xi + 1) begin
-        x_q[xi] <= {ANG_W{1'b0}};
-        x_warm[xi] <= {QD_W{1'b0}};
-      end
       for (xi = 0; xi < 4; xi = xi + 1) begin
         x_vw[xi] <= {VLW{1'b0}};
         x_vv[xi] <= {VLW{1'b0}};
@@ -288,14 +266,19 @@ module ts_core_solve #(
       if (!x_g) begin
         if (x_f < 4'd3)       x_jw[{x_j, x_f[1:0]}] <= in_x_data[JWW-1:0];
         else if (x_f < 4'd6)  x_jv[{x_j, x_f3}] <= in_x_data[JVW-1:0];
-        else if (x_f == 4'd6) x_q[x_j] <= in_x_data[ANG_W-1:0];
-        else if (x_f == 4'd7) x_warm[x_j] <= in_x_data[QD_W-1:0];
       end else begin
         if (x_f < 4'd3)       x_vw[x_f[1:0]] <= in_x_data[VLW-1:0];
         else if (x_f < 4'd6)  x_vv[x_f3] <= in_x_data[VLW-1:0];
       end
     end
   end
+
+  // per-joint words of joint col (ts_ram instances before the sequencer)
+  wire signed [ANG_W-1:0] cl_lo, cl_hi, xc_q;
+  wire signed [QD_W-1:0]  cl_vmax, xc_warm, blo_c, bhi_c;
+  wire signed [MUW-1:0]   cl_mu;
+  wire signed [STW-1:0]   cst_c;
+  wire signed [KW-1:0]    kst_c;
 
   // ---- sequencer state ---------------------------------------------------------------------------
   localparam [4:0] S_IDLE = 5'd0, S_WAIT = 5'd1, S_ISSUE = 5'd2, S_RINIT = 5'd3, S_COL = 5'd4,
@@ -348,7 +331,7 @@ module ts_core_solve #(
   ts_resize #(.IN_W(JSW), .LSH(0), .OUT_W(MAW)) u_ajs (.in(js_bi), .out(a_js));
   ts_resize #(.IN_W(MNF + 2), .LSH(0), .OUT_W(MAW)) u_am (.in({1'b0, mr_q}), .out(a_m));
   ts_resize #(.IN_W(RCW), .LSH(0), .OUT_W(MAW)) u_ay0 (.in(y0_q), .out(a_y0));
-  ts_resize #(.IN_W(MUW), .LSH(0), .OUT_W(MAW)) u_amu (.in(cfg_mu[col]), .out(a_mu));
+  ts_resize #(.IN_W(MUW), .LSH(0), .OUT_W(MAW)) u_amu (.in(cl_mu), .out(a_mu));
   ts_resize #(.IN_W(KLW), .LSH(0), .OUT_W(MAW)) u_akl (.in(cfg_klim), .out(a_klim));
   ts_resize #(.IN_W(GKW), .LSH(0), .OUT_W(MAW)) u_agk (.in(gk_q), .out(a_gk));
   ts_resize #(.IN_W(QD_W), .LSH(0), .OUT_W(MAW)) u_aqd (.in(qd[col]), .out(a_qd));
@@ -368,7 +351,7 @@ module ts_core_solve #(
   ts_resize #(.IN_W(QFW), .LSH(0), .OUT_W(MBW)) u_bdhi (.in(dhi), .out(b_dhi));
   ts_resize #(.IN_W(QD_W), .LSH(0), .OUT_W(MBW)) u_brb (.in(rb_q), .out(b_rb));
   ts_resize #(.IN_W(TW_W), .LSH(0), .OUT_W(MBW)) u_bro (.in(ro_bi), .out(b_ro));
-  ts_resize #(.IN_W(STW), .LSH(0), .OUT_W(MBW)) u_bc (.in(cst[col]), .out(b_c));
+  ts_resize #(.IN_W(STW), .LSH(0), .OUT_W(MBW)) u_bc (.in(cst_c), .out(b_c));
   ts_resize #(.IN_W(DTW), .LSH(0), .OUT_W(MBW)) u_bdt (.in(cfg_dt), .out(b_dt));
 
   reg signed [MAW-1:0] mul_a;
@@ -457,16 +440,16 @@ module ts_core_solve #(
 
   // bounds: vmin = cvt<qd_t>(-vmax), cvt<qdiff_t>(lo - q), cvt<qdiff_t>(hi - q), cvt<qd_t>(klim d)
   wire signed [QD_W:0] vmax_x;
-  ts_resize #(.IN_W(QD_W), .LSH(0), .OUT_W(QD_W + 1)) u_vmx (.in(cfg_vmax[col]), .out(vmax_x));
+  ts_resize #(.IN_W(QD_W), .LSH(0), .OUT_W(QD_W + 1)) u_vmx (.in(cl_vmax), .out(vmax_x));
   wire signed [QD_W:0] nvmax = -vmax_x;
   wire signed [QD_W-1:0] vmin_o;
   wire vmin_s;
   ts_round_sat #(.IN_W(QD_W + 1), .SHIFT(0), .OUT_W(QD_W), .SAT(1))
     u_r_vmin (.clk(clk), .rst(rst), .in_x(nvmax), .out_y(vmin_o), .out_sat(vmin_s));
   wire signed [ANG_W:0] lo_x, hi_x, q_x;
-  ts_resize #(.IN_W(ANG_W), .LSH(0), .OUT_W(ANG_W + 1)) u_lox (.in(cfg_lo[col]), .out(lo_x));
-  ts_resize #(.IN_W(ANG_W), .LSH(0), .OUT_W(ANG_W + 1)) u_hix (.in(cfg_hi[col]), .out(hi_x));
-  ts_resize #(.IN_W(ANG_W), .LSH(0), .OUT_W(ANG_W + 1)) u_qx (.in(x_q[col]), .out(q_x));
+  ts_resize #(.IN_W(ANG_W), .LSH(0), .OUT_W(ANG_W + 1)) u_lox (.in(cl_lo), .out(lo_x));
+  ts_resize #(.IN_W(ANG_W), .LSH(0), .OUT_W(ANG_W + 1)) u_hix (.in(cl_hi), .out(hi_x));
+  ts_resize #(.IN_W(ANG_W), .LSH(0), .OUT_W(ANG_W + 1)) u_qx (.in(xc_q), .out(q_x));
   wire signed [ANG_W:0] dlo_in = lo_x - q_x;
   wire signed [ANG_W:0] dhi_in = hi_x - q_x;
   wire dlo_s, dhi_s;
@@ -485,7 +468,7 @@ module ts_core_solve #(
   // exact comparisons of the position bounds with the velocity interval
   wire signed [CMW-1:0] vmin_c, vmax_c, plo_c, phi_c;
   ts_resize #(.IN_W(QD_W), .LSH(PLF - QDF), .OUT_W(CMW)) u_vminc (.in(vmin_o), .out(vmin_c));
-  ts_resize #(.IN_W(QD_W), .LSH(PLF - QDF), .OUT_W(CMW)) u_vmaxc (.in(cfg_vmax[col]), .out(vmax_c));
+  ts_resize #(.IN_W(QD_W), .LSH(PLF - QDF), .OUT_W(CMW)) u_vmaxc (.in(cl_vmax), .out(vmax_c));
   ts_resize #(.IN_W(PLW), .LSH(0), .OUT_W(CMW)) u_ploc (.in(plo_q), .out(plo_c));
   ts_resize #(.IN_W(PLW), .LSH(0), .OUT_W(CMW)) u_phic (.in(phi_q), .out(phi_c));
 
@@ -522,7 +505,7 @@ module ts_core_solve #(
   // The shift and its rounding half come from joint col's k_i, registered every cycle: S_GSH
   // follows the dot burst of the same col, so the variable-index read and the decoder leave the
   // path into gsh_q (no cycle added).
-  wire signed [9:0] t_s = {{(10 - KW){kst[col][KW-1]}}, kst[col]} + TOFF10;
+  wire signed [9:0] t_s = {{(10 - KW){kst_c[KW-1]}}, kst_c} + TOFF10;
   wire [6:0] t_u = t_s[6:0];
   wire [GXW-1:0] one_g = {{(GXW - 1){1'b0}}, 1'b1};
   wire signed [GXW-1:0] half_g = (t_u == 7'd0) ? {GXW{1'b0}} : $signed(one_g << (t_u - 7'd1));
@@ -559,7 +542,7 @@ module ts_core_solve #(
 
   // q_next = cvt<angle_t>(q + q' dt)
   wire signed [NIW-1:0] q_al, p_nal, qx_in;
-  ts_resize #(.IN_W(ANG_W), .LSH(NSF - AF), .OUT_W(NIW)) u_qal (.in(x_q[col]), .out(q_al));
+  ts_resize #(.IN_W(ANG_W), .LSH(NSF - AF), .OUT_W(NIW)) u_qal (.in(xc_q), .out(q_al));
   ts_resize #(.IN_W(PW), .LSH(NSF - NPF), .OUT_W(NIW)) u_pnal (.in(p), .out(p_nal));
   assign qx_in = q_al + p_nal;
   wire signed [ANG_W-1:0] qx_o;
@@ -603,7 +586,7 @@ module ts_core_solve #(
   // cycle (warm_lq): S_WARM follows S_BND3 with the same col, so it sees joint col's value one
   // cycle old, and the variable-index read, the shift and the subtraction leave the path into
   // qd[col] (no cycle added).
-  wire signed [QD_W-1:0] warm_x = x_warm[col];
+  wire signed [QD_W-1:0] warm_x = xc_warm;
   wire signed [QD_W-1:0] warm_sh = warm_x >>> cfg_leak;
   wire signed [QD_W-1:0] warm_l = (cfg_leak == 5'd0) ? warm_x : (warm_x - warm_sh);
   reg  signed [QD_W-1:0] warm_lq;
@@ -613,8 +596,8 @@ module ts_core_solve #(
   // sweep step clamp; joint col's bounds registered every cycle (col is stable through a step)
   reg  signed [QD_W-1:0] blo_cq, bhi_cq;
   always @(posedge clk) begin
-    blo_cq <= blo[col];
-    bhi_cq <= bhi[col];
+    blo_cq <= blo_c;
+    bhi_cq <= bhi_c;
   end
   wire signed [QD_W-1:0] qn_t = (bhi_cq < qn_o) ? bhi_cq : qn_o;
   wire signed [QD_W-1:0] qn_c = (blo_cq < qn_t) ? qn_t : blo_cq;
@@ -623,22 +606,47 @@ module ts_core_solve #(
   reg  signed [ANG_W-1:0] lo_cq, hi_cq;
   reg                     lim_cq;
   always @(posedge clk) begin
-    lo_cq <= cfg_lo[col];
-    hi_cq <= cfg_hi[col];
+    lo_cq <= cl_lo;
+    hi_cq <= cl_hi;
     lim_cq <= cfg_lim[col];
   end
   wire signed [ANG_W-1:0] qx_t = (hi_cq < qx_o) ? hi_cq : qx_o;
   wire signed [ANG_W-1:0] qx_c = (lo_cq < qx_t) ? qx_t : lo_cq;
   // active-limit flags of joint col
-  wire lo_hit = !(blo[col] < qd[col]);
-  wire hi_hit = !(qd[col] < bhi[col]);
+  wire lo_hit = !(blo_c < qd[col]);
+  wire hi_hit = !(qd[col] < bhi_c);
   wire lim_act = (blo_pos[col] && lo_hit) || (bhi_pos[col] && hi_hit);
   wire vlim_act = ((!blo_pos[col] && lo_hit) || (!bhi_pos[col] && hi_hit))
-                  && (cfg_vmax[col] != {1'b0, {(QD_W - 1){1'b1}}});
+                  && (cl_vmax != {1'b0, {(QD_W - 1){1'b1}}});
 
   wire last_col = ({1'b0, col} == n_q - 1'b1);
   wire signed [ACW-1:0] p_acc;
   ts_resize #(.IN_W(PW), .LSH(0), .OUT_W(ACW)) u_pacc (.in(p), .out(p_acc));
+
+  // ---- per-joint memories (ts_ram: distributed RAM on ECP5, no reset) -------------------------------
+  // configuration and inputs as written; c and k of joint col at S_C (or S_NORM2), its bounds at
+  // S_WARM
+  wire cfg_jwe = in_cfg_we && !cfg_g && !rst;
+  wire x_jwe = in_x_we && !x_g && !rst;
+  ts_ram #(.W(ANG_W), .AW(JI_W), .R(1)) u_cfg_lo (.clk(clk), .in_we(cfg_jwe && (cfg_f == 4'd0)),
+    .in_waddr(cfg_j), .in_wdata(in_cfg_data[ANG_W-1:0]), .in_raddr(col), .out_rdata(cl_lo));
+  ts_ram #(.W(ANG_W), .AW(JI_W), .R(1)) u_cfg_hi (.clk(clk), .in_we(cfg_jwe && (cfg_f == 4'd1)),
+    .in_waddr(cfg_j), .in_wdata(in_cfg_data[ANG_W-1:0]), .in_raddr(col), .out_rdata(cl_hi));
+  ts_ram #(.W(QD_W), .AW(JI_W), .R(1)) u_cfg_vmax (.clk(clk), .in_we(cfg_jwe && (cfg_f == 4'd2)),
+    .in_waddr(cfg_j), .in_wdata(in_cfg_data[QD_W-1:0]), .in_raddr(col), .out_rdata(cl_vmax));
+  ts_ram #(.W(MUW), .AW(JI_W), .R(1)) u_cfg_mu (.clk(clk), .in_we(cfg_jwe && (cfg_f == 4'd3)),
+    .in_waddr(cfg_j), .in_wdata(in_cfg_data[MUW-1:0]), .in_raddr(col), .out_rdata(cl_mu));
+  ts_ram #(.W(ANG_W), .AW(JI_W), .R(1)) u_x_q (.clk(clk), .in_we(x_jwe && (x_f == 4'd6)),
+    .in_waddr(x_j), .in_wdata(in_x_data[ANG_W-1:0]), .in_raddr(col), .out_rdata(xc_q));
+  ts_ram #(.W(QD_W), .AW(JI_W), .R(1)) u_x_warm (.clk(clk), .in_we(x_jwe && (x_f == 4'd7)),
+    .in_waddr(x_j), .in_wdata(in_x_data[QD_W-1:0]), .in_raddr(col), .out_rdata(xc_warm));
+  // (c, k of a zero column, |Js_col|^2 = 0: both 0, written at S_NORM2)
+  wire ck_zero = (state == S_NORM2) && dzero;
+  ts_ram #(.W(STW + KW), .AW(JI_W), .R(1)) u_ck (.clk(clk), .in_we(((state == S_C) || ck_zero) && !rst),
+    .in_waddr(col), .in_wdata(ck_zero ? {(STW + KW){1'b0}} : {c_o, k_q}), .in_raddr(col),
+    .out_rdata({cst_c, kst_c}));
+  ts_ram #(.W(2 * QD_W), .AW(JI_W), .R(1)) u_bnd (.clk(clk), .in_we((state == S_WARM) && !rst),
+    .in_waddr(col), .in_wdata({hi_q, lo_q}), .in_raddr(col), .out_rdata({bhi_c, blo_c}));
 
   // ---- sequencer -----------------------------------------------------------------------------------
   always @(posedge clk) begin
@@ -653,7 +661,6 @@ module ts_core_solve #(
       qnc_q <= {QD_W{1'b0}}; flags <= 32'd0;
       out_busy <= 1'b0; out_done <= 1'b0; out_r <= {(6 * TW_W){1'b0}}; out_flags <= 32'd0;
       for (ri = 0; ri < NMAX; ri = ri + 1) begin
-        cst[ri] <= {STW{1'b0}}; kst[ri] <= {KW{1'b0}}; blo[ri] <= {QD_W{1'b0}}; bhi[ri] <= {QD_W{1'b0}};
         blo_pos[ri] <= 1'b0; bhi_pos[ri] <= 1'b0; qd[ri] <= {QD_W{1'b0}}; qnext[ri] <= {ANG_W{1'b0}};
       end
       for (ri = 0; ri < 6; ri = ri + 1) begin
@@ -737,8 +744,7 @@ module ts_core_solve #(
         S_NORM2: begin
           y0_q <= rom[mr_q[MNF-1 -: T]];
           if (dzero) begin
-            cst[col] <= {STW{1'b0}};
-            kst[col] <= {KW{1'b0}};
+            // c = k = 0 (written to u_ck in this state)
             state <= S_BND0;
           end else begin
             // m y0 (operands registered in the next cycle, when y0_q holds the seed)
@@ -765,8 +771,6 @@ module ts_core_solve #(
           state <= S_WAIT;
         end
         S_C: begin
-          cst[col] <= c_o;
-          kst[col] <= k_q;
           if (c_s) flags[8] <= 1'b1;
           state <= S_BND0;
         end
@@ -793,11 +797,11 @@ module ts_core_solve #(
           state <= S_WAIT;
         end
         S_BND3: begin
-          lo_q <= vmin_o; hi_q <= cfg_vmax[col]; lo_pos_q <= 1'b0; hi_pos_q <= 1'b0;
+          lo_q <= vmin_o; hi_q <= cl_vmax; lo_pos_q <= 1'b0; hi_pos_q <= 1'b0;
           if (cfg_lim[col]) begin
             if (vmin_c < plo_c) begin
               lo_pos_q <= 1'b1;
-              if (vmax_c < plo_c) lo_q <= cfg_vmax[col];
+              if (vmax_c < plo_c) lo_q <= cl_vmax;
               else begin
                 lo_q <= plo_o;
                 if (plo_s) flags[8] <= 1'b1;
@@ -815,7 +819,7 @@ module ts_core_solve #(
           state <= S_WARM;
         end
         S_WARM: begin
-          blo[col] <= lo_q; bhi[col] <= hi_q; blo_pos[col] <= lo_pos_q; bhi_pos[col] <= hi_pos_q;
+          blo_pos[col] <= lo_pos_q; bhi_pos[col] <= hi_pos_q;
           qd[col] <= warm_c;
           rb_q <= warm_c;
           // racc -= Js_col q'_col

@@ -198,6 +198,7 @@ DEPS = {
     "ts_round_sat": [],
     "ts_ecp5_mult18": [],
     "ts_sel": [],
+    "ts_ram": [],
     "ts_mul": ["ts_resize", "ts_delay", "ts_ecp5_mult18"],
     "ts_mul_bank": ["ts_mul", "ts_sel", "ts_delay"],
     "ts_quat_mul": ["ts_mul_bank", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
@@ -207,9 +208,9 @@ DEPS = {
     "ts_screw_transport": ["ts_quat_rotate", "ts_mul_bank", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
 }
 DEPS["ts_core_fk"] = ["ts_joint_quat", "ts_sincos", "ts_quat_mul", "ts_quat_rotate", "ts_screw_transport", "ts_mul",
-                      "ts_resize", "ts_delay", "ts_round_sat"]
+                      "ts_resize", "ts_delay", "ts_round_sat", "ts_ram"]
 DEPS["ts_core_commit"] = ["ts_mul", "ts_resize", "ts_delay", "ts_ecp5_mult18", "ts_sel"]
-DEPS["ts_core_solve"] = ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat", "ts_ecp5_mult18"]
+DEPS["ts_core_solve"] = ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat", "ts_ecp5_mult18", "ts_ram"]
 DEPS["ts_core_law"] = ["ts_quat_mul", "ts_quat_rotate", "ts_mul_bank", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"]
 DEPS["ts_servo_core"] = ["ts_servo_regs", "ts_core_commit", "ts_core_fk", "ts_core_law", "ts_core_solve", "ts_sel"]
 DEPS["ts_servo_regs"] = ["ts_sel"]
@@ -316,8 +317,12 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
                 jobs.append(("ts_mul", sources("ts_mul", target), {"A_W": aw, "B_W": bw, "TARGET": target}))
         for iw, sh, ow, sa in round_sat_sets(cfg):
             jobs.append(("ts_round_sat", sources("ts_round_sat"), {"IN_W": iw, "SHIFT": sh, "OUT_W": ow, "SAT": sa}))
-    for w, d in ((1, 0), (1, 1), (8, 2), (81, 40)):
-        jobs.append(("ts_delay", sources("ts_delay"), {"W": w, "DEPTH": d}))
+    # the delay line: wire, register, shift register, rings in a memory (2, 16 and 24 words)
+    for w, d, ram in ((1, 0, 0), (1, 1, 0), (8, 2, 0), (81, 40, 0), (8, 3, 1), (54, 17, 1), (108, 25, 1)):
+        jobs.append(("ts_delay", sources("ts_delay"), {"W": w, "DEPTH": d, "RAM": ram}))
+    # the per-joint memory: one and two read ports, one address bit
+    for w, aw, r in ((18, 3, 1), (54, 3, 2), (8, 1, 1), (96, 5, 2)):
+        jobs.append(("ts_ram", sources("ts_ram"), {"W": w, "AW": aw, "R": r}))
     for iw, l, ow in ((8, 0, 12), (8, 0, 8), (12, 0, 8), (8, 3, 14), (8, 3, 11), (8, 3, 9)):
         jobs.append(("ts_resize", sources("ts_resize"), {"IN_W": iw, "LSH": l, "OUT_W": ow}))
     jobs.append(("ts_ecp5_mult18", sources("ts_ecp5_mult18", "ECP5"), {}))
