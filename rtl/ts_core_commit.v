@@ -174,7 +174,26 @@ module ts_core_commit #(
   output wire [NMAX*QD_W-1:0]        out_joint_vmax,
   output wire [NMAX*MU_W-1:0]        out_joint_mu,
   // k = cvt<kturn_t>(s inv4pi) per joint (0 for prismatic joints)
-  output wire [NMAX*KT_W-1:0]        out_joint_kturn
+  output wire [NMAX*KT_W-1:0]        out_joint_kturn,
+  // The loader's port: while idle (out_busy = 0) the checks' joint multiplexers select joint
+  // in_ld_j of the shadow, and out_ld_* show its words (the core's loader reads the shadow through
+  // them instead of a second set of multiplexers); during a commit they follow the checks.
+  input  wire [7:0]                  in_ld_j,
+  output wire [QUAT_W-1:0]           out_ld_qo0,
+  output wire [QUAT_W-1:0]           out_ld_qo1,
+  output wire [QUAT_W-1:0]           out_ld_qo2,
+  output wire [QUAT_W-1:0]           out_ld_qo3,
+  output wire [QUAT_W-1:0]           out_ld_ax0,
+  output wire [QUAT_W-1:0]           out_ld_ax1,
+  output wire [QUAT_W-1:0]           out_ld_ax2,
+  output wire [LEN_W-1:0]            out_ld_pox,
+  output wire [LEN_W-1:0]            out_ld_poy,
+  output wire [LEN_W-1:0]            out_ld_poz,
+  output wire [SCALE_W-1:0]          out_ld_s,
+  output wire [ANGLE_W-1:0]          out_ld_lo,
+  output wire [ANGLE_W-1:0]          out_ld_hi,
+  output wire [QD_W-1:0]             out_ld_vmax,
+  output wire [MU_W-1:0]             out_ld_mu
 );
 
   `include "ts_common.vh"
@@ -367,14 +386,18 @@ module ts_core_commit #(
   endgenerate
 
   // ---- operand selection (issue side) -------------------------------------------------------------
+  // joint of the issue-side and consume-side multiplexers: the checks' while busy, else the loader's
+  wire [JI_W-1:0] iss_jm = out_busy ? iss_j : in_ld_j[JI_W-1:0];
+  wire [JI_W-1:0] c_jm;
+  wire unused_ld_j = ^in_ld_j;
   wire [QUAT_W-1:0] i_qo0, i_qo1, i_qo2, i_qo3, i_ax0, i_ax1, i_ax2;
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq0 (.in_vec(sh_qo0), .in_idx(iss_j), .out_el(i_qo0));
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq1 (.in_vec(sh_qo1), .in_idx(iss_j), .out_el(i_qo1));
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq2 (.in_vec(sh_qo2), .in_idx(iss_j), .out_el(i_qo2));
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq3 (.in_vec(sh_qo3), .in_idx(iss_j), .out_el(i_qo3));
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_ia0 (.in_vec(sh_ax0), .in_idx(iss_j), .out_el(i_ax0));
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_ia1 (.in_vec(sh_ax1), .in_idx(iss_j), .out_el(i_ax1));
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_ia2 (.in_vec(sh_ax2), .in_idx(iss_j), .out_el(i_ax2));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq0 (.in_vec(sh_qo0), .in_idx(iss_jm), .out_el(i_qo0));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq1 (.in_vec(sh_qo1), .in_idx(iss_jm), .out_el(i_qo1));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq2 (.in_vec(sh_qo2), .in_idx(iss_jm), .out_el(i_qo2));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq3 (.in_vec(sh_qo3), .in_idx(iss_jm), .out_el(i_qo3));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_ia0 (.in_vec(sh_ax0), .in_idx(iss_jm), .out_el(i_ax0));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_ia1 (.in_vec(sh_ax1), .in_idx(iss_jm), .out_el(i_ax1));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_ia2 (.in_vec(sh_ax2), .in_idx(iss_jm), .out_el(i_ax2));
   reg [QUAT_W-1:0] q_sel;
   always @* begin
     q_sel = sh_bq0;
@@ -403,9 +426,9 @@ module ts_core_commit #(
   end
   wire [SCALE_W-1:0] s_iss;
   wire [ANGLE_W-1:0] i_lo, i_hi;
-  ts_sel #(.W(SCALE_W), .N(NMAX), .IW(JI_W)) u_sel_is (.in_vec(sh_s), .in_idx(iss_j), .out_el(s_iss));
-  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_ilo (.in_vec(sh_lo), .in_idx(iss_j), .out_el(i_lo));
-  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_ihi (.in_vec(sh_hi), .in_idx(iss_j), .out_el(i_hi));
+  ts_sel #(.W(SCALE_W), .N(NMAX), .IW(JI_W)) u_sel_is (.in_vec(sh_s), .in_idx(iss_jm), .out_el(s_iss));
+  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_ilo (.in_vec(sh_lo), .in_idx(iss_jm), .out_el(i_lo));
+  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_ihi (.in_vec(sh_hi), .in_idx(iss_jm), .out_el(i_hi));
   wire [ANGLE_W-1:0] lim_iss = (iss_k == 4'd8) ? i_lo : i_hi;
   // joint c_j's words as the consume stage takes them
   wire [SCALE_W-1:0] cj_s;
@@ -413,14 +436,14 @@ module ts_core_commit #(
   wire [QD_W-1:0] cj_vmax;
   wire [MU_W-1:0] cj_mu;
   wire [LEN_W-1:0] cj_pox, cj_poy, cj_poz;
-  ts_sel #(.W(SCALE_W), .N(NMAX), .IW(JI_W)) u_sel_cs (.in_vec(sh_s), .in_idx(c_j), .out_el(cj_s));
-  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_clo (.in_vec(sh_lo), .in_idx(c_j), .out_el(cj_lo));
-  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_chi (.in_vec(sh_hi), .in_idx(c_j), .out_el(cj_hi));
-  ts_sel #(.W(QD_W), .N(NMAX), .IW(JI_W)) u_sel_cvm (.in_vec(sh_vmax), .in_idx(c_j), .out_el(cj_vmax));
-  ts_sel #(.W(MU_W), .N(NMAX), .IW(JI_W)) u_sel_cmu (.in_vec(sh_mu), .in_idx(c_j), .out_el(cj_mu));
-  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_cpx (.in_vec(sh_pox), .in_idx(c_j), .out_el(cj_pox));
-  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_cpy (.in_vec(sh_poy), .in_idx(c_j), .out_el(cj_poy));
-  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_cpz (.in_vec(sh_poz), .in_idx(c_j), .out_el(cj_poz));
+  ts_sel #(.W(SCALE_W), .N(NMAX), .IW(JI_W)) u_sel_cs (.in_vec(sh_s), .in_idx(c_jm), .out_el(cj_s));
+  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_clo (.in_vec(sh_lo), .in_idx(c_jm), .out_el(cj_lo));
+  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_chi (.in_vec(sh_hi), .in_idx(c_jm), .out_el(cj_hi));
+  ts_sel #(.W(QD_W), .N(NMAX), .IW(JI_W)) u_sel_cvm (.in_vec(sh_vmax), .in_idx(c_jm), .out_el(cj_vmax));
+  ts_sel #(.W(MU_W), .N(NMAX), .IW(JI_W)) u_sel_cmu (.in_vec(sh_mu), .in_idx(c_jm), .out_el(cj_mu));
+  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_cpx (.in_vec(sh_pox), .in_idx(c_jm), .out_el(cj_pox));
+  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_cpy (.in_vec(sh_poy), .in_idx(c_jm), .out_el(cj_poy));
+  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_cpz (.in_vec(sh_poz), .in_idx(c_jm), .out_el(cj_poz));
   wire [RB-1:0] reach_op = {1'b0, reach[RB-2:0]};
 
   wire signed [MA_W-1:0] qa, sa, ma;
@@ -446,6 +469,22 @@ module ts_core_commit #(
   wire [1:0]       c_ph = t_out[TAG_W-2 -: 2];
   wire [3:0]       c_k = t_out[TAG_W-4 -: 4];
   wire [JI_W-1:0]  c_j = t_out[JI_W-1:0];
+  assign c_jm = out_busy ? c_j : in_ld_j[JI_W-1:0];
+  assign out_ld_qo0 = i_qo0;
+  assign out_ld_qo1 = i_qo1;
+  assign out_ld_qo2 = i_qo2;
+  assign out_ld_qo3 = i_qo3;
+  assign out_ld_ax0 = i_ax0;
+  assign out_ld_ax1 = i_ax1;
+  assign out_ld_ax2 = i_ax2;
+  assign out_ld_pox = cj_pox;
+  assign out_ld_poy = cj_poy;
+  assign out_ld_poz = cj_poz;
+  assign out_ld_s = cj_s;
+  assign out_ld_lo = cj_lo;
+  assign out_ld_hi = cj_hi;
+  assign out_ld_vmax = sh_vlim[c_jm] ? cj_vmax : QDMAX_C;   // as out_joint_vmax
+  assign out_ld_mu = cj_mu;
 
   // ---- consume-side arithmetic --------------------------------------------------------------------
   wire [ACC_W-1:0] p_acc;

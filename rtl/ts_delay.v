@@ -9,7 +9,9 @@
 //     output register.  The words are not reset: a fill flag holds the output at 0 until every word
 //     has been written since the reset.  W flip-flops and about W / 4 * ceil((DEPTH - 1) / 16)
 //     RAM blocks instead of DEPTH * W flip-flops.
-// The default takes the ring for data lines (W >= 4) of DEPTH >= 3.
+// The default takes the ring for data lines (W >= 4) of DEPTH >= 13: a ring costs about 1.5 LUT
+// sites per bit on ECP5 (a DPR16X4 is 6), a shift register DEPTH flip-flops, and the core is short
+// of LUTs, not of flip-flops, once the long lines are rings.
 // Language: Verilog 2005
 `resetall
 `timescale 1ns / 1ps
@@ -21,7 +23,7 @@ module ts_delay #(
   // Delay in clock cycles (>= 0)
   parameter DEPTH = 1,
   // 1: ring buffer in a memory (DEPTH >= 3), 0: shift register (see the header)
-  parameter RAM = ((W >= 4) && (DEPTH >= 3)) ? 1 : 0
+  parameter RAM = ((W >= 4) && (DEPTH >= 13)) ? 1 : 0
 ) (
   input  wire         clk,
   input  wire         rst,

@@ -168,6 +168,14 @@ module ts_servo_core #(
   wire [NMAX*MU_W-1:0] c_mu;
   wire [NMAX*KT_W-1:0] c_kturn;
 
+  // the loader's joint and that joint's shadow words, through the commit engine's multiplexers
+  wire [7:0] ld_j8;
+  wire [QUAT_W-1:0] j_oqw, j_oqx, j_oqy, j_oqz, j_ax, j_ay, j_az;
+  wire [LEN_W-1:0] j_opx, j_opy, j_opz;
+  wire [SCALE_W-1:0] j_sc;
+  wire [ANGLE_W-1:0] j_lo, j_hi;
+  wire [QD_W-1:0] j_vm;
+  wire [MU_W-1:0] j_mu;
   ts_core_commit #(.NMAX(NMAX), .CONFIG(CONFIG), .TARGET(TARGET)) u_commit (
     .clk(clk), .rst(rst), .in_start(c_start),
     .in_njoints(r_njoints), .in_mode_err_b(r_err_b), .in_mode_error_only(r_err_only),
@@ -197,8 +205,15 @@ module ts_servo_core #(
     .out_joint_origin_qz(c_oqz), .out_joint_origin_px(c_opx), .out_joint_origin_py(c_opy),
     .out_joint_origin_pz(c_opz), .out_joint_axis_x(c_ax), .out_joint_axis_y(c_ay), .out_joint_axis_z(c_az),
     .out_joint_scale(c_scale), .out_joint_lower(c_lower), .out_joint_upper(c_upper),
-    .out_joint_vmax(c_vmax), .out_joint_mu(c_mu), .out_joint_kturn(c_kturn)
+    .out_joint_vmax(c_vmax), .out_joint_mu(c_mu), .out_joint_kturn(c_kturn),
+    .in_ld_j(ld_j8), .out_ld_qo0(j_oqw), .out_ld_qo1(j_oqx), .out_ld_qo2(j_oqy), .out_ld_qo3(j_oqz),
+    .out_ld_ax0(j_ax), .out_ld_ax1(j_ay), .out_ld_ax2(j_az), .out_ld_pox(j_opx), .out_ld_poy(j_opy),
+    .out_ld_poz(j_opz), .out_ld_s(j_sc), .out_ld_lo(j_lo), .out_ld_hi(j_hi), .out_ld_vmax(j_vm),
+    .out_ld_mu(j_mu)
   );
+  // The shadow's joint buses: the loader reads them through out_ld_* (kturn excepted)
+  wire unused_shadow = ^{c_oqw, c_oqx, c_oqy, c_oqz, c_ax, c_ay, c_az, c_opx, c_opy, c_opz, c_scale,
+                         c_lower, c_upper, c_vmax, c_mu};
 
   // ---- sequencer state ---------------------------------------------------------------------------
   reg [3:0] st;
@@ -249,39 +264,12 @@ module ts_servo_core #(
   reg [CD_W-1:0] sv_cd;
   reg sv_cv;
 
+  wire [8+JI_W-1:0] lj_x = {8'd0, lj};
+  assign ld_j8 = lj_x[7:0];
+  wire unused_lj_x = ^lj_x[8+JI_W-1:8];
   // sign extension of the shadow words to 32 / CD_W bits
-  wire [QUAT_W-1:0] j_oqw;
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_j_oqw (.in_vec(c_oqw), .in_idx(lj), .out_el(j_oqw));
-  wire [QUAT_W-1:0] j_oqx;
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_j_oqx (.in_vec(c_oqx), .in_idx(lj), .out_el(j_oqx));
-  wire [QUAT_W-1:0] j_oqy;
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_j_oqy (.in_vec(c_oqy), .in_idx(lj), .out_el(j_oqy));
-  wire [QUAT_W-1:0] j_oqz;
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_j_oqz (.in_vec(c_oqz), .in_idx(lj), .out_el(j_oqz));
-  wire [QUAT_W-1:0] j_ax;
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_j_ax (.in_vec(c_ax), .in_idx(lj), .out_el(j_ax));
-  wire [QUAT_W-1:0] j_ay;
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_j_ay (.in_vec(c_ay), .in_idx(lj), .out_el(j_ay));
-  wire [QUAT_W-1:0] j_az;
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_j_az (.in_vec(c_az), .in_idx(lj), .out_el(j_az));
-  wire [LEN_W-1:0] j_opx;
-  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_j_opx (.in_vec(c_opx), .in_idx(lj), .out_el(j_opx));
-  wire [LEN_W-1:0] j_opy;
-  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_j_opy (.in_vec(c_opy), .in_idx(lj), .out_el(j_opy));
-  wire [LEN_W-1:0] j_opz;
-  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_j_opz (.in_vec(c_opz), .in_idx(lj), .out_el(j_opz));
-  wire [SCALE_W-1:0] j_sc;
-  ts_sel #(.W(SCALE_W), .N(NMAX), .IW(JI_W)) u_sel_j_sc (.in_vec(c_scale), .in_idx(lj), .out_el(j_sc));
   wire [KT_W-1:0] j_kt;
   ts_sel #(.W(KT_W), .N(NMAX), .IW(JI_W)) u_sel_j_kt (.in_vec(c_kturn), .in_idx(lj), .out_el(j_kt));
-  wire [ANGLE_W-1:0] j_lo;
-  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_j_lo (.in_vec(c_lower), .in_idx(lj), .out_el(j_lo));
-  wire [ANGLE_W-1:0] j_hi;
-  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_j_hi (.in_vec(c_upper), .in_idx(lj), .out_el(j_hi));
-  wire [QD_W-1:0] j_vm;
-  ts_sel #(.W(QD_W), .N(NMAX), .IW(JI_W)) u_sel_j_vm (.in_vec(c_vmax), .in_idx(lj), .out_el(j_vm));
-  wire [MU_W-1:0] j_mu;
-  ts_sel #(.W(MU_W), .N(NMAX), .IW(JI_W)) u_sel_j_mu (.in_vec(c_mu), .in_idx(lj), .out_el(j_mu));
 
   always @(*) begin
     fk_cd = 32'd0;

@@ -1050,43 +1050,20 @@ module ts_servo_regs #(
   wire        rd_ok = rd_glb ? rd_glb_ok : (rd_jnt && rd_jnt_ok);
   wire [31:0] rd_data = rd_glb ? rd_glb_data : rd_jnt_data;
 
+  // Read word of the global block: one 32:1 multiplexer tree (ts_sel) over its words, unmapped
+  // words 0 (SLVERR)
+  localparam [31:0] GLB_MAPPED = 32'b01111111011111110111111111111111;
+  wire [1024-1:0] glb_vec = {32'd0, rd_tool_pz, rd_tool_py, rd_tool_px, rd_tool_qz,
+      rd_tool_qy, rd_tool_qx, rd_tool_qw, 32'd0, rd_base_pz,
+      rd_base_py, rd_base_px, rd_base_qz, rd_base_qy, rd_base_qx,
+      rd_base_qw, 32'd0, rd_dt, rd_klim, rd_lchar, rd_ko, rd_kp,
+      rd_mode, rd_njoints, rd_hwcfg, rd_id, rd_tick_cycles,
+      rd_tick_count, rd_flags, rd_cfg_error, rd_status, rd_ctrl};
+  wire [31:0] glb_word;
+  ts_sel #(.W(32), .N(32), .IW(5)) u_rd_glb (.in_vec(glb_vec), .in_idx(ar_word[4:0]), .out_el(glb_word));
   always @* begin
-    rd_glb_ok = 1'b1;
-    case (ar_word[5:0])
-      6'h00: rd_glb_data = rd_ctrl;
-      6'h01: rd_glb_data = rd_status;
-      6'h02: rd_glb_data = rd_cfg_error;
-      6'h03: rd_glb_data = rd_flags;
-      6'h04: rd_glb_data = rd_tick_count;
-      6'h05: rd_glb_data = rd_tick_cycles;
-      6'h06: rd_glb_data = rd_id;
-      6'h07: rd_glb_data = rd_hwcfg;
-      6'h08: rd_glb_data = rd_njoints;
-      6'h09: rd_glb_data = rd_mode;
-      6'h0A: rd_glb_data = rd_kp;
-      6'h0B: rd_glb_data = rd_ko;
-      6'h0C: rd_glb_data = rd_lchar;
-      6'h0D: rd_glb_data = rd_klim;
-      6'h0E: rd_glb_data = rd_dt;
-      6'h10: rd_glb_data = rd_base_qw;
-      6'h11: rd_glb_data = rd_base_qx;
-      6'h12: rd_glb_data = rd_base_qy;
-      6'h13: rd_glb_data = rd_base_qz;
-      6'h14: rd_glb_data = rd_base_px;
-      6'h15: rd_glb_data = rd_base_py;
-      6'h16: rd_glb_data = rd_base_pz;
-      6'h18: rd_glb_data = rd_tool_qw;
-      6'h19: rd_glb_data = rd_tool_qx;
-      6'h1A: rd_glb_data = rd_tool_qy;
-      6'h1B: rd_glb_data = rd_tool_qz;
-      6'h1C: rd_glb_data = rd_tool_px;
-      6'h1D: rd_glb_data = rd_tool_py;
-      6'h1E: rd_glb_data = rd_tool_pz;
-      default: begin
-        rd_glb_data = 32'd0;
-        rd_glb_ok = 1'b0;
-      end
-    endcase
+    rd_glb_data = glb_word;
+    rd_glb_ok = (ar_word[5:5] == 1'd0) && GLB_MAPPED[ar_word[4:0]];
   end
 
   always @(posedge clk) begin

@@ -17,6 +17,7 @@ from __future__ import annotations
 import json
 import math
 import os
+import random
 import re
 from pathlib import Path
 
@@ -537,7 +538,7 @@ def check_fits(cfg: str, raw: dict) -> None:
 
 if cocotb is not None:
     from cocotb.clock import Clock
-    from cocotb.triggers import FallingEdge, RisingEdge
+    from cocotb.triggers import FallingEdge, RisingEdge, Timer
 
     async def drive(dut, words: dict) -> None:
         for k, v in words.items():
@@ -555,8 +556,10 @@ if cocotb is not None:
         if disturb is not None:
             await drive(dut, port_words(cfg, disturb))
         cyc = 1
+        ld_rnd = random.Random(int(os.environ["TS_SEED"]) + cyc)
         while not int(dut.out_done.value):
             assert int(dut.out_busy.value) == 1, "out_busy dropped before out_done"
+            dut.in_ld_j.value = ld_rnd.randrange(NMAX)   # the loader's joint is ignored while busy
             await FallingEdge(dut.clk)
             cyc += 1
             assert cyc < 2000, "commit did not finish"
@@ -580,7 +583,28 @@ if cocotb is not None:
             assert (vm >> (j * qw)) & ((1 << qw) - 1) == exp & ((1 << qw) - 1), f"out_joint_vmax joint {j}"
         await FallingEdge(dut.clk)
         assert int(dut.out_done.value) == 0, "out_done longer than one cycle"
+        await check_loader_port(dut)
         return res, cyc
+
+    #: the loader's port: out_ld_* -> the shadow bus with joint j's word
+    LD_PORTS = [("qo0", "joint_origin_qw"), ("qo1", "joint_origin_qx"), ("qo2", "joint_origin_qy"),
+                ("qo3", "joint_origin_qz"), ("ax0", "joint_axis_x"), ("ax1", "joint_axis_y"),
+                ("ax2", "joint_axis_z"), ("pox", "joint_origin_px"), ("poy", "joint_origin_py"),
+                ("poz", "joint_origin_pz"), ("s", "joint_scale"), ("lo", "joint_lower"),
+                ("hi", "joint_upper"), ("vmax", "joint_vmax"), ("mu", "joint_mu")]
+
+    async def check_loader_port(dut) -> None:
+        """While idle, out_ld_* show joint in_ld_j's shadow words (the core's loader reads them)."""
+        for j in range(NMAX):
+            dut.in_ld_j.value = j
+            await Timer(1, units="ns")
+            for ld, bus in LD_PORTS:
+                w = len(getattr(dut, f"out_ld_{ld}"))
+                want = (int(getattr(dut, f"out_{bus}").value) >> (j * w)) & ((1 << w) - 1)
+                got = int(getattr(dut, f"out_ld_{ld}").value)
+                assert got == want, f"out_ld_{ld} for joint {j}: {got:#x}, shadow {want:#x}"
+        dut.in_ld_j.value = 0
+        await FallingEdge(dut.clk)      # back on the bench's phase (inputs change at falling edges)
 
     def compare(cfg: str, name: str, raw: dict, res: dict, exp: dict, cyc: int) -> None:
         ok = exp["code"] == 0
@@ -604,6 +628,7 @@ if cocotb is not None:
         cocotb.start_soon(Clock(dut.clk, 10, units="ns").start())
         dut.rst.value = 1
         dut.in_start.value = 0
+        dut.in_ld_j.value = 0
         await drive(dut, port_words(cfg, raw_from_chain(robots.load("puma560"), cfg)))
         for _ in range(4):
             await FallingEdge(dut.clk)

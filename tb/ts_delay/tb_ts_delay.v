@@ -31,8 +31,8 @@ module tb_ts_delay #(
   ts_delay #(.W(W), .DEPTH(1)) u_d1 (.clk(clk), .rst(rst), .din(in_d), .dout(out_d1));
   ts_delay #(.W(W), .DEPTH(D), .RAM(1)) u_dd (.clk(clk), .rst(rst), .din(in_d), .dout(out_dd));
   ts_delay #(.W(W), .DEPTH(D), .RAM(0)) u_ds (.clk(clk), .rst(rst), .din(in_d), .dout(out_ds));
-  ts_delay #(.W(W), .DEPTH(3)) u_d3 (.clk(clk), .rst(rst), .din(in_d), .dout(out_d3));
-  ts_delay #(.W(W), .DEPTH(17)) u_d17 (.clk(clk), .rst(rst), .din(in_d), .dout(out_d17));
+  ts_delay #(.W(W), .DEPTH(3), .RAM(1)) u_d3 (.clk(clk), .rst(rst), .din(in_d), .dout(out_d3));
+  ts_delay #(.W(W), .DEPTH(17), .RAM(1)) u_d17 (.clk(clk), .rst(rst), .din(in_d), .dout(out_d17));
   ts_delay #(.W(1), .DEPTH(D)) u_valid (.clk(clk), .rst(rst), .din(in_valid), .dout(out_valid));
 
 endmodule
