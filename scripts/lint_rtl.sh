@@ -3,30 +3,41 @@
 # multiplier targets; the list comes from tb/rtlparams.py, i.e. from the model's formats):
 #   verilator --lint-only -Wall   (no waivers; the ECP5 target uses tb/sim/MULT18X18D.v)
 #   iverilog -g2005               (compile/elaborate as Verilog-2005)
-# Usage: scripts/lint_rtl.sh [-j N]      Exit status 1 if any job reports anything.
+# Usage: scripts/lint_rtl.sh [-j N] [-s K/M]   Exit status 1 if any job reports anything.
+#   -s K/M: only every M-th job from job K (0 <= K < M), so that M runs can share the list
+#           (make test runs two shards side by side).
 set -u -o pipefail
 cd "$(dirname "$0")/.."
 JOBS=2
-if [ "${1:-}" = "-j" ]; then JOBS="$2"; fi
+SHARD=0
+SHARDS=1
+while [ $# -gt 0 ]; do
+  case "$1" in
+    -j) JOBS="$2"; shift 2 ;;
+    -s) SHARD="${2%/*}"; SHARDS="${2#*/}"; shift 2 ;;
+    *) echo "lint_rtl.sh: unknown argument $1" >&2; exit 2 ;;
+  esac
+done
 PY="${PYTHON:-.venv/bin/python}"
 [ -x "$PY" ] || PY=python3
 command -v verilator >/dev/null || { echo "lint_rtl.sh: verilator not found" >&2; exit 2; }
 command -v iverilog >/dev/null || { echo "lint_rtl.sh: iverilog not found" >&2; exit 2; }
 
-OUT=build/lint
+OUT=build/lint/shard$SHARD-of-$SHARDS
 rm -rf "$OUT"; mkdir -p "$OUT"
+export OUT
 "$PY" tb/rtlparams.py lint-jobs > "$OUT/jobs.txt" || exit 2
 
 lint_one() {   # $1 = job number, reads the job line from jobs.txt
   local n="$1" line top files params
-  line=$(sed -n "${n}p" build/lint/jobs.txt)
+  line=$(sed -n "${n}p" "$OUT/jobs.txt")
   IFS=$'\t' read -r top files params <<< "$line"
   local vargs=() iargs=() kv
   for kv in $params; do
     vargs+=("-G$kv")
     iargs+=("-P$top.$kv")
   done
-  local log="build/lint/job$n.log"
+  local log="$OUT/job$n.log"
   {
     echo "== $top $params"
     # shellcheck disable=SC2086
@@ -40,11 +51,13 @@ lint_one() {   # $1 = job number, reads the job line from jobs.txt
 }
 export -f lint_one
 
-N=$(wc -l < "$OUT/jobs.txt")
-seq 1 "$N" | xargs -P "$JOBS" -I{} bash -c 'lint_one {}'
+TOTAL=$(wc -l < "$OUT/jobs.txt")
+MINE=$(seq 1 "$TOTAL" | awk -v k="$SHARD" -v m="$SHARDS" '(($1 - 1) % m) == k')
+N=$(echo "$MINE" | grep -c .)
+echo "$MINE" | xargs -P "$JOBS" -I{} bash -c 'lint_one {}'
 
 fail=0
-for n in $(seq 1 "$N"); do
+for n in $MINE; do
   log="$OUT/job$n.log"
   # a clean job logs exactly its header and the return codes
   if [ "$(grep -c . "$log")" -ne 2 ] || ! grep -q "rc verilator=0 iverilog=0" "$log"; then
@@ -53,6 +66,6 @@ for n in $(seq 1 "$N"); do
   fi
 done
 if [ "$fail" -eq 0 ]; then
-  echo "lint_rtl.sh: $N jobs clean (verilator --lint-only -Wall, iverilog -g2005)"
+  echo "lint_rtl.sh: $N jobs clean (verilator --lint-only -Wall, iverilog -g2005; shard $SHARD of $SHARDS, $TOTAL jobs in all)"
 fi
 exit "$fail"
