@@ -591,16 +591,16 @@ module ts_core_solve #(
   wire signed [QD_W-1:0] warm_l = (cfg_leak == 5'd0) ? warm_x : (warm_x - warm_sh);
   reg  signed [QD_W-1:0] warm_lq;
   always @(posedge clk) warm_lq <= warm_l;
-  wire signed [QD_W-1:0] warm_t = (hi_q < warm_lq) ? hi_q : warm_lq;
-  wire signed [QD_W-1:0] warm_c = (lo_q < warm_t) ? warm_t : lo_q;
+  wire signed [QD_W-1:0] warm_c;
+  ts_clamp #(.W(QD_W)) u_warm_c (.in_x(warm_lq), .in_lo(lo_q), .in_hi(hi_q), .out_y(warm_c));
   // sweep step clamp; joint col's bounds registered every cycle (col is stable through a step)
   reg  signed [QD_W-1:0] blo_cq, bhi_cq;
   always @(posedge clk) begin
     blo_cq <= blo_c;
     bhi_cq <= bhi_c;
   end
-  wire signed [QD_W-1:0] qn_t = (bhi_cq < qn_o) ? bhi_cq : qn_o;
-  wire signed [QD_W-1:0] qn_c = (blo_cq < qn_t) ? qn_t : blo_cq;
+  wire signed [QD_W-1:0] qn_c;
+  ts_clamp #(.W(QD_W)) u_qn_c (.in_x(qn_o), .in_lo(blo_cq), .in_hi(bhi_cq), .out_y(qn_c));
   // integration clamp; joint col's limits registered every cycle (S_QNX2 follows S_WAIT with the
   // same col), so the variable-index reads leave the path into qnext[col] (no cycle added)
   reg  signed [ANG_W-1:0] lo_cq, hi_cq;
@@ -610,8 +610,8 @@ module ts_core_solve #(
     hi_cq <= cl_hi;
     lim_cq <= cfg_lim[col];
   end
-  wire signed [ANG_W-1:0] qx_t = (hi_cq < qx_o) ? hi_cq : qx_o;
-  wire signed [ANG_W-1:0] qx_c = (lo_cq < qx_t) ? qx_t : lo_cq;
+  wire signed [ANG_W-1:0] qx_c;
+  ts_clamp #(.W(ANG_W)) u_qx_c (.in_x(qx_o), .in_lo(lo_cq), .in_hi(hi_cq), .out_y(qx_c));
   // active-limit flags of joint col
   wire lo_hit = !(blo_c < qd[col]);
   wire hi_hit = !(qd[col] < bhi_c);

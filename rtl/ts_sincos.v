@@ -168,8 +168,12 @@ module ts_sincos #(
     end
   endgenerate
   always @(posedge clk) bank_sel <= index_rd[T_BITS-1:LO];
+  // bank select as a 4:1 multiplexer tree (ts_sel): the part-select banks[bank_sel*2*TAB_W +: ...]
+  // became a MULT18X18D for the index and a barrel shifter, the FK engine's critical path (79 MHz)
+  wire [2*TAB_W-1:0] bank_q;
+  ts_sel #(.W(2*TAB_W), .N(4), .IW(2)) u_bank (.in_vec(banks), .in_idx(bank_sel), .out_el(bank_q));
   reg [2*TAB_W-1:0] rom_q;
-  always @(posedge clk) rom_q <= banks[bank_sel*2*TAB_W +: 2*TAB_W];
+  always @(posedge clk) rom_q <= bank_q;
 
   // ---- Sh, Ch, Csd, Ssd = cvt<trig_acc_t>(...) --------------------------------------------------
   // h = d2 / 2 is d2 with one more fraction bit; d2 and sd are delayed to meet the table words

@@ -18,6 +18,9 @@ while [ $# -gt 0 ]; do
     *) echo "lint_rtl.sh: unknown argument $1" >&2; exit 2 ;;
   esac
 done
+[[ "$SHARD" =~ ^[0-9]+$ && "$SHARDS" =~ ^[0-9]+$ && "$SHARDS" -ge 1 && "$SHARD" -lt "$SHARDS" ]] ||
+  { echo "lint_rtl.sh: -s K/M: need integers with 0 <= K < M, got '$SHARD/$SHARDS'" >&2; exit 2; }
+[[ "$JOBS" =~ ^[1-9][0-9]*$ ]] || { echo "lint_rtl.sh: -j N: need a positive integer, got '$JOBS'" >&2; exit 2; }
 PY="${PYTHON:-.venv/bin/python}"
 [ -x "$PY" ] || PY=python3
 command -v verilator >/dev/null || { echo "lint_rtl.sh: verilator not found" >&2; exit 2; }

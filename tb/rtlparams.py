@@ -198,19 +198,20 @@ DEPS = {
     "ts_round_sat": [],
     "ts_ecp5_mult18": [],
     "ts_sel": [],
+    "ts_clamp": [],
     "ts_ram": [],
     "ts_mul": ["ts_resize", "ts_delay", "ts_ecp5_mult18"],
     "ts_mul_bank": ["ts_mul", "ts_sel", "ts_delay"],
     "ts_quat_mul": ["ts_mul_bank", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
     "ts_quat_rotate": ["ts_mul_bank", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
-    "ts_sincos": ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
+    "ts_sincos": ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat", "ts_sel"],
     "ts_joint_quat": ["ts_sincos", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
     "ts_screw_transport": ["ts_quat_rotate", "ts_mul_bank", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"],
 }
 DEPS["ts_core_fk"] = ["ts_joint_quat", "ts_sincos", "ts_quat_mul", "ts_quat_rotate", "ts_screw_transport", "ts_mul",
                       "ts_resize", "ts_delay", "ts_round_sat", "ts_ram"]
 DEPS["ts_core_commit"] = ["ts_mul", "ts_resize", "ts_delay", "ts_ecp5_mult18", "ts_sel"]
-DEPS["ts_core_solve"] = ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat", "ts_ecp5_mult18", "ts_ram"]
+DEPS["ts_core_solve"] = ["ts_mul", "ts_resize", "ts_delay", "ts_round_sat", "ts_ecp5_mult18", "ts_ram", "ts_clamp"]
 DEPS["ts_core_law"] = ["ts_quat_mul", "ts_quat_rotate", "ts_mul_bank", "ts_mul", "ts_resize", "ts_delay", "ts_round_sat"]
 DEPS["ts_servo_core"] = ["ts_servo_regs", "ts_core_commit", "ts_core_fk", "ts_core_law", "ts_core_solve", "ts_sel"]
 DEPS["ts_servo_regs"] = ["ts_sel"]
@@ -329,6 +330,9 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
     # the multiplexer: the shapes of its bench (power of two, padded, index bits above the tree, one element)
     for w, n, iw in ((18, 8, 3), (32, 6, 3), (27, 20, 5), (18, 7, 3), (27, 9, 4), (5, 1, 1)):
         jobs.append(("ts_sel", sources("ts_sel"), {"W": w, "N": n, "IW": iw}))
+    # the clamp: the solver's widths and a narrow one
+    for w in (4, 32, 40):
+        jobs.append(("ts_clamp", sources("ts_clamp"), {"W": w}))
     # the multiplier bank: parallel, folded with and without padding slots, one multiplier
     for n, fold in ((6, 1), (16, 4), (9, 7), (6, 6), (3, 7)):
         for target in TARGETS:

@@ -19,3 +19,13 @@ def test_lint_rtl(shard):
     assert m, p.stdout[-2000:]
     n, k, total = map(int, m.groups())
     assert k == shard and n == len(range(shard, total, 2)) and total > 100
+
+
+@pytest.mark.parametrize("args,field", [(["-s", "2/2"], "-s K/M"), (["-s", "a/b"], "-s K/M"), (["-s", "0/0"], "-s K/M"),
+                                        (["-j", "0"], "-j N"), (["--fast"], "--fast")])
+def test_lint_rtl_bad_arguments(args, field):
+    """A shard that would select no job, a zero job count or an unknown option: one line naming it, exit 2."""
+    p = subprocess.run(["bash", str(ROOT / "scripts" / "lint_rtl.sh"), *args], cwd=ROOT, capture_output=True,
+                       text=True, timeout=60)
+    assert p.returncode == 2 and p.stdout == ""
+    assert len(p.stderr.strip().splitlines()) == 1 and field in p.stderr, p.stderr
