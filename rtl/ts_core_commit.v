@@ -368,6 +368,13 @@ module ts_core_commit #(
   reg [QD_W-1:0]  cur_vmax;
   reg [MU_W-1:0]  cur_mu;
   reg [LEN_W+1:0] cur_l1;
+  // |p_i| in two consume steps (k 0, k 1): the joint's select, then the sum.  At k 0 the sign-
+  // flipped components (x ^ s) and the signs s; at k 1 the sum with the signs as carries, since
+  // |x| = (x ^ s) + s.  In one step (select, negate, two adds) it was the commit engine's
+  // critical path (15 ns post-route on LFE5U-85F -6).
+  reg [LEN_W-1:0] cur_fx, cur_fy, cur_fz;
+  reg [2:0]       cur_sg;
+  wire [1:0]      sg_n = {1'b0, cur_sg[0]} + {1'b0, cur_sg[1]} + {1'b0, cur_sg[2]};
   reg [RW-1:0]    reach;
   reg [LEN_W+1:0] l1pb;
   reg [SCALE_W-1:0] smax_abs, smax_s;
@@ -657,6 +664,10 @@ module ts_core_commit #(
       cur_vmax <= {QD_W{1'b0}};
       cur_mu <= {MU_W{1'b0}};
       cur_l1 <= {(LEN_W+2){1'b0}};
+      cur_fx <= {LEN_W{1'b0}};
+      cur_fy <= {LEN_W{1'b0}};
+      cur_fz <= {LEN_W{1'b0}};
+      cur_sg <= 3'b000;
       reach <= {RW{1'b0}};
       l1pb <= {(LEN_W+2){1'b0}};
       smax_abs <= {SCALE_W{1'b0}};
@@ -786,8 +797,13 @@ module ts_core_commit #(
                 cur_hi <= cj_hi;
                 cur_vmax <= cj_vmax;
                 cur_mu <= cj_mu;
-                cur_l1 <= l1(cj_pox, cj_poy, cj_poz);
+                cur_fx <= cj_pox ^ {LEN_W{cj_pox[LEN_W-1]}};
+                cur_fy <= cj_poy ^ {LEN_W{cj_poy[LEN_W-1]}};
+                cur_fz <= cj_poz ^ {LEN_W{cj_poz[LEN_W-1]}};
+                cur_sg <= {cj_poz[LEN_W-1], cj_poy[LEN_W-1], cj_pox[LEN_W-1]};
               end
+              if (c_k == 4'd1)
+                cur_l1 <= ({2'b00, cur_fx} + {2'b00, cur_fy}) + ({2'b00, cur_fz} + {{LEN_W{1'b0}}, sg_n});
               if (c_k <= 4'd6) acc <= acc_next;
               if (c_k == 4'd3) qo_ok <= unit_ok;
               if (c_k == 4'd6) ax_ok <= unit_ok;

