@@ -527,10 +527,18 @@ module ts_core_commit #(
   endgenerate
 
   // ---- checks of the evaluated joint -------------------------------------------------------------
-  wire             s_zero = (cur_s == {SCALE_W{1'b0}});
-  wire             lo_gt_hi = $signed(cur_hi) < $signed(cur_lo);
-  wire             vmax_bad = cur_vmax[QD_W-1] || (cur_vmax == {QD_W{1'b0}});
+  // The comparisons are registered every cycle: cur_* are taken at k 0 and smax_abs at the previous
+  // joint's check, both at least ten cycles before jev, so the registered flags are those of the
+  // current words when jev acts (the comparators, the error priority and the enables fanning out
+  // from it were the commit engine's critical path in one cycle, 14.5 ns post-route).
   wire [SCALE_W-1:0] s_abs = cur_s[SCALE_W-1] ? -cur_s : cur_s;
+  reg              s_zero, lo_gt_hi, vmax_bad, s_gt_max;
+  always @(posedge clk) begin
+    s_zero <= (cur_s == {SCALE_W{1'b0}});
+    lo_gt_hi <= $signed(cur_hi) < $signed(cur_lo);
+    vmax_bad <= cur_vmax[QD_W-1] || (cur_vmax == {QD_W{1'b0}});
+    s_gt_max <= s_abs > smax_abs;
+  end
   wire [RW-1:0]    l1_w, stroke_w;
   generate
     if (RW > LEN_W + 2) begin : g_l1w
@@ -838,7 +846,7 @@ module ts_core_commit #(
                 for (ki = 0; ki < NMAX; ki = ki + 1)
                   if ({{(32 - JI_W){1'b0}}, ev_j} == ki) sh_kt[ki*KT_W +: KT_W] <= cur_pris ? {KT_W{1'b0}} : kt_val;
                 reach <= reach_next;
-                if (s_abs > smax_abs) begin
+                if (s_gt_max) begin
                   smax_abs <= s_abs;
                   smax_s <= cur_s;
                 end
