@@ -54,3 +54,17 @@ def test_critical_path_reads_the_last_report():
 
 def test_critical_path_absent():
     assert synth_core.critical_path("Info: Program finished normally.\n") is None
+
+
+def test_engines_table_rows():
+    """--engines: one row per engine; a routed engine shows its Fmax and path, one without a routed
+    log is reported as not finished, never as a figure."""
+    cp = synth_core.critical_path(ROUTED)
+    res = {"default": {"engines_pnr": {"device": "LFE5U-85F", "seed": 1, "ts_core_solve": {
+        "fmax": 165.56, "path": cp, "counts": {"LUT4": 10, "FF": 20, "MULT18X18D": 4}}}}}
+    rows = [r for r in synth_core.engines_section(res, ["default"]) if r.startswith("| default |")]
+    assert len(rows) == len(synth_core.ENGINES)
+    solve = next(r for r in rows if "`ts_core_solve`" in r)
+    assert "| 10 | 20 | 4 | 165.6 |" in solve and "`rtl/ts_clamp.v:27`" in solve
+    assert all("routing not finished" in r for r in rows if r is not solve)
+    assert synth_core.engines_section({"default": {}}, ["default"]) == []
