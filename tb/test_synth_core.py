@@ -68,3 +68,32 @@ def test_engines_table_rows():
     assert "| 10 | 20 | 4 | 165.6 |" in solve and "`rtl/ts_clamp.v:27`" in solve
     assert all("routing not finished" in r for r in rows if r is not solve)
     assert synth_core.engines_section({"default": {}}, ["default"]) == []
+
+
+def test_nextpnr_cmd_router():
+    """The router reaches nextpnr's command line; an unknown router is refused before anything runs."""
+    cmd = synth_core.nextpnr_cmd("--85k", Path("a.json"), 3, Path("a.log"), "router1")
+    i = cmd.index("--router")
+    assert cmd[i + 1] == "router1" and cmd[cmd.index("--seed") + 1] == "3" and "--85k" in cmd
+    assert synth_core.nextpnr_cmd("--45k", Path("a.json"), 1, Path("a.log"))[i + 1] == synth_core.DEFAULT_ROUTER
+    try:
+        synth_core.nextpnr_cmd("--85k", Path("a.json"), 1, Path("a.log"), "router3")
+    except ValueError as e:
+        assert "router3" in str(e)
+    else:
+        raise AssertionError("router3 accepted")
+
+
+def test_section_names_router_and_device():
+    """The generated text says which router ran and where each configuration was placed; a core
+    routed on a larger device than its goal's is not reported as placed on the goal's device."""
+    assert synth_core.routers({"default": {"router": "router2"}, "compact": {}}) == "`--router router1` / `--router router2`"
+    assert synth_core.places({"default": {}, "compact": {}}) == "the smallest ECP5 the counts fit"
+    both = {"default": {"place_on": "LFE5U-85F"}, "compact": {"place_on": "LFE5U-85F"}}
+    assert synth_core.places(both) == "default on LFE5U-85F (`--place-on`); compact on LFE5U-85F (`--place-on`)"
+    assert synth_core.places({"compact": {"place_on": "LFE5U-85F"}}) == "compact on LFE5U-85F (`--place-on`)"
+    r = {"fmax": [80.0], "device": "LFE5U-85F"}
+    assert synth_core.placed_note(r, "LFE5U-45F") == "placed and routed on LFE5U-85F, not on LFE5U-45F"
+    assert synth_core.placed_note(r, "LFE5U-85F") == "placed and routed on LFE5U-85F"
+    assert synth_core.placed_note({"fmax": [], "comb": 1234, "device": "LFE5U-45F"}, "LFE5U-45F") == \
+        "nextpnr on LFE5U-45F: 1,234 TRELLIS_COMB; routing not finished"
