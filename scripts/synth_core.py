@@ -15,9 +15,10 @@ is reported with the count that does not fit; nothing is placed then.
     .venv/bin/python scripts/synth_core.py --configs default --engines   # + each engine placed alone
     .venv/bin/python scripts/synth_core.py --place-on LFE5U-85F           # make synth-core
 
-The configurations run side by side. router2 is the default router: on the whole default core
-(73 % of LFE5U-85F's logic cells) router1 left ~118,000 of 275,328 arcs unrouted after an hour
-and stopped converging.
+The configurations run side by side. router2 is the default router: it routed the whole compact
+core on LFE5U-85F; on the whole default core (74 % of LFE5U-85F's logic cells) router1 left ~118,000
+of 275,328 arcs unrouted after an hour, and router2 still had ~36,600 overused wires after 13
+iterations (2026-11-23; neither finished).
 
 --engines places and routes each engine (ts_core_fk, ts_core_solve, ts_core_law, ts_core_commit,
 ts_servo_regs) alone, out of context, on --engine-device, and reports its post-route Fmax and the RTL
@@ -172,7 +173,8 @@ def counts(c: dict[str, int]) -> dict[str, int]:
             "MULT18X18D": c.get("MULT18X18D", 0), "EBR": c.get("DP16KD", 0), "DPR16X4": c.get("TRELLIS_DPR16X4", 0)}
 
 
-#: nextpnr's routers; router2 (negotiated congestion, as in VPR) is the one that routes the whole core
+#: nextpnr's routers; router2 (negotiated congestion, as in VPR) routed the whole compact core in
+#: 43 iterations; router1 stalled on the default core
 ROUTERS = ("router1", "router2")
 DEFAULT_ROUTER = "router2"
 
@@ -322,6 +324,9 @@ def pnr_logs(d: Path) -> dict:
             left = re.findall(r"^Info:\s+\d+ \|\s+\d+\s+\d+ \|\s+\d+\s+\d+ \|\s+(\d+)\|", text, re.M)
             if arcs and left:
                 out["route_progress"] = (int(arcs[0]), int(left[-1]))
+            r2 = re.findall(r"iter=(\d+) wires=\d+ overused=(\d+)", text)     # router2
+            if r2:
+                out["route_overused"] = (int(r2[-1][0]), int(r2[-1][1]))
         m = re.search(r"TRELLIS_COMB:\s+(\d+)/", text)
         out["comb"] = int(m.group(1)) if m else out["comb"]
     return out
@@ -418,9 +423,11 @@ def section(res: dict, cycles: dict) -> str:
         if f:
             fs = f"{min(f):.1f} worst of {len(f)} seed(s)"
         elif r.get("fmax_placed"):
-            rp = r.get("route_progress")
+            rp, ro = r.get("route_progress"), r.get("route_overused")
             fs = (f"routing not finished ({rp[1]:,} of {rp[0]:,} arcs left when stopped); post-placement estimate "
-                  f"{r['fmax_placed']:.1f}" if rp else f"post-placement estimate {r['fmax_placed']:.1f}")
+                  f"{r['fmax_placed']:.1f}" if rp else
+                  f"routing not finished (router2 stopped at iteration {ro[0]} with {ro[1]:,} wires overused); "
+                  f"post-placement estimate {r['fmax_placed']:.1f}" if ro else f"post-placement estimate {r['fmax_placed']:.1f}")
         else:
             if not any(ok for _, ok in r["fits"]):
                 fs = "not placed (does not fit)"

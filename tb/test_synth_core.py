@@ -97,3 +97,15 @@ def test_section_names_router_and_device():
     assert synth_core.placed_note(r, "LFE5U-85F") == "placed and routed on LFE5U-85F"
     assert synth_core.placed_note({"fmax": [], "comb": 1234, "device": "LFE5U-45F"}, "LFE5U-45F") == \
         "nextpnr on LFE5U-45F: 1,234 TRELLIS_COMB; routing not finished"
+
+
+def test_pnr_logs_router2_progress(tmp_path, monkeypatch):
+    """An unfinished router2 run is reported with its last iteration and overused wires, and no Fmax."""
+    monkeypatch.setattr(synth_core, "ROOT", tmp_path)
+    (tmp_path / "pnr_LFE5U-85F_seed1.log").write_text(
+        "Info: Max frequency for clock 'clk': 32.77 MHz (FAIL at 200.00 MHz)\nInfo: Running main router loop...\n"
+        "Info:     iter=1 wires=100 overused=50 overuse=60 archfail=NA\n"
+        "Info:     iter=2 wires=120 overused=36618 overuse=37426 archfail=NA\n")
+    r = synth_core.pnr_logs(Path("."))
+    assert r["fmax"] == [] and r["fmax_placed"] == 32.77 and r["route_overused"] == (2, 36618)
+    assert r["device"] == "LFE5U-85F"
