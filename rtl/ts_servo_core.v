@@ -263,6 +263,27 @@ module ts_servo_core #(
   reg fk_cv;
   reg [CD_W-1:0] sv_cd;
   reg sv_cv;
+  // The loader's write port is registered: the word selected at ld (through the commit engine's
+  // joint multiplexers and the field case below) is written one cycle later at ld_q.  Without the
+  // register this select ran straight into the engines' memories across the chip (the compact
+  // core's critical path post-route, 20.8 ns).  LOAD lasts one cycle more (ld_fin).
+  reg [LA_W-1:0] ld_q;
+  reg fk_we_q, sv_we_q;
+  reg [31:0] fk_cd_q;
+  reg [CD_W-1:0] sv_cd_q;
+  reg ld_fin;                     // LOAD: the last address was selected, its write is under way
+  always @(posedge clk) begin
+    if (rst) begin
+      ld_q <= {LA_W{1'b0}}; fk_we_q <= 1'b0; sv_we_q <= 1'b0; fk_cd_q <= 32'd0;
+      sv_cd_q <= {CD_W{1'b0}};
+    end else begin
+      ld_q <= ld;
+      fk_we_q <= (st == S_LOAD) && !ld_fin && fk_cv;
+      sv_we_q <= (st == S_LOAD) && !ld_fin && sv_cv;
+      fk_cd_q <= fk_cd;
+      sv_cd_q <= sv_cd;
+    end
+  end
 
   wire [8+JI_W-1:0] lj_x = {8'd0, lj};
   assign ld_j8 = lj_x[7:0];
@@ -360,7 +381,7 @@ module ts_servo_core #(
 
   ts_core_fk #(.NMAX(NMAX), .CONFIG(CONFIG), .ROM_FILE(TRIG_ROM), .TARGET(TARGET), .FOLD(FOLD)) u_fk (
     .clk(clk), .rst(rst),
-    .in_cfg_we((st == S_LOAD) && fk_cv), .in_cfg_addr(ld), .in_cfg_data(fk_cd),
+    .in_cfg_we(fk_we_q), .in_cfg_addr(ld_q), .in_cfg_data(fk_cd_q),
     .in_q_we(in_prep && !psub), .in_q_addr(pjj), .in_q_data(q_sel),
     .in_start(fk_start), .out_busy(fk_busy), .out_done(fk_done), .out_sat(fk_sat),
     .out_tool_q_w(tq_w), .out_tool_q_x(tq_x), .out_tool_q_y(tq_y), .out_tool_q_z(tq_z),
@@ -448,7 +469,7 @@ module ts_servo_core #(
 
   ts_core_solve #(.NMAX(NMAX), .CONFIG(CONFIG), .ROM_FILE(RECIP_ROM), .TARGET(TARGET)) u_solve (
     .clk(clk), .rst(rst),
-    .in_cfg_we((st == S_LOAD) && sv_cv), .in_cfg_addr(ld), .in_cfg_data(sv_cd),
+    .in_cfg_we(sv_we_q), .in_cfg_addr(ld_q), .in_cfg_data(sv_cd_q),
     .in_x_we(sv_xwe), .in_x_addr(sv_xa), .in_x_data(sv_xd),
     .in_start(sv_start), .in_n(n_c), .out_busy(sv_busy), .out_done(sv_done),
     .out_qd(sv_qd), .out_q_next(sv_qn), .out_r(sv_r), .out_flags(sv_flags)
@@ -493,7 +514,7 @@ module ts_servo_core #(
   integer k;
   always @(posedge clk) begin
     if (rst) begin
-      st <= S_IDLE; pend <= 1'b0; loaded <= 1'b0; ld <= {LA_W{1'b0}}; wi <= {WI_W{1'b0}};
+      st <= S_IDLE; pend <= 1'b0; loaded <= 1'b0; ld <= {LA_W{1'b0}}; ld_fin <= 1'b0; wi <= {WI_W{1'b0}};
       bad <= 1'b0; ctl <= 2'd0; use_int <= 1'b0; qbuf <= {(JN * ANGLE_W){1'b0}};
       q_int <= {(JN * ANGLE_W){1'b0}}; qd_prev <= {(JN * QD_W){1'b0}};
       pj <= {(JI_W + 1){1'b0}}; psub <= 1'b0; cyc <= 32'd0; status_w <= 32'd0; ow <= {WI_W{1'b0}};
@@ -548,8 +569,11 @@ module ts_servo_core #(
           end
         end
         S_LOAD: begin
-          ld <= ld + 1'b1;
-          if (ld == {LA_W{1'b1}}) begin loaded <= 1'b1; st <= S_IDLE; end
+          if (ld_fin) begin ld_fin <= 1'b0; loaded <= 1'b1; st <= S_IDLE; end
+          else begin
+            ld <= ld + 1'b1;
+            if (ld == {LA_W{1'b1}}) ld_fin <= 1'b1;
+          end
         end
         S_PREP: begin
           psub <= ~psub;
