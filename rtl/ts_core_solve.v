@@ -279,15 +279,41 @@ module ts_core_solve #(
   wire signed [MUW-1:0]   cl_mu;
   wire signed [STW-1:0]   cst_c;
   wire signed [KW-1:0]    kst_c;
+  // preparation streams: per joint the normalised |Js_j|^2 ({zero, k, m, y0}) read at col (the
+  // issue), at the product's joint and at the rounded product's joint; e_j, then y_j, at col; the
+  // position differences and vmin at col and at the bound decision's joint; vmax there
+  localparam NRW = 1 + KW + MNF + 1 + RCW;
+  localparam DDW = QD_W + 2 * QFW;
+  wire [NRW-1:0]          nrm_c, nrm_p, nrm_r;
+  wire [MNF:0]            mr_c = nrm_c[RCW +: MNF + 1];
+  wire signed [RCW-1:0]   y0_c = nrm_c[RCW-1:0];
+  wire signed [RCW-1:0]   y0_p = nrm_p[RCW-1:0];
+  wire signed [KW-1:0]    k_r = nrm_r[RCW + MNF + 1 +: KW];
+  wire                    dz_r = nrm_r[NRW-1];
+  wire unused_nrm = ^{nrm_c[NRW-1:RCW + MNF + 1], nrm_p[NRW-1:RCW], nrm_r[RCW + MNF:0]};
+  wire signed [RCW-1:0]   ey_c;
+  wire [DDW-1:0]          dd_c, dd_b;
+  wire signed [QFW-1:0]   dlo_c = dd_c[QFW-1:0];
+  wire signed [QFW-1:0]   dhi_c = dd_c[QFW +: QFW];
+  wire signed [QD_W-1:0]  vmin_b = dd_b[2 * QFW +: QD_W];
+  wire unused_dd = ^{dd_c[DDW-1:2 * QFW], dd_b[2 * QFW - 1:0]};
+  wire signed [QD_W-1:0]  vmax_b;
+  // the integration stream: q at the product's joint, the limits, bounds and vmax at the rounded one
+  wire signed [ANG_W-1:0] xq_p, lo_r1, hi_r1;
+  wire signed [QD_W-1:0]  blo_r, bhi_r, vmax_r;
 
   // ---- sequencer state ---------------------------------------------------------------------------
-  localparam [4:0] S_IDLE = 5'd0, S_WAIT = 5'd1, S_ISSUE = 5'd2, S_RINIT = 5'd3, S_COL = 5'd4,
-                   S_DOTD = 5'd5, S_NORM = 5'd6, S_NORM2 = 5'd7, S_E = 5'd8, S_Y = 5'd9, S_C = 5'd10,
-                   S_BND0 = 5'd11, S_BND1 = 5'd12, S_BND2 = 5'd13, S_BND3 = 5'd14, S_WARM = 5'd15,
+  localparam [4:0] S_IDLE = 5'd0, S_WAIT = 5'd1, S_ISSUE = 5'd2, S_RINIT = 5'd3, S_STREAM = 5'd4,
+                   S_PD = 5'd6, S_PE = 5'd7, S_PY = 5'd8, S_PC = 5'd9, S_PB = 5'd10,
+                   S_PW0 = 5'd11, S_PW1 = 5'd12, S_PW2 = 5'd14, S_PW = 5'd13,
                    S_SWEEP = 5'd16, S_GSH = 5'd17, S_GK = 5'd18, S_QN = 5'd19, S_DQ = 5'd20,
-                   S_NEXTJ = 5'd21, S_QNX = 5'd22, S_QNX2 = 5'd23, S_DONE = 5'd24, S_COLNEXT = 5'd25;
-  // burst modes (six products, one per row, issued on consecutive cycles)
-  localparam [1:0] M_COL = 2'd0, M_DOT = 2'd1, M_RUPD = 2'd2;
+                   S_NEXTJ = 5'd21, S_QNX = 5'd22, S_DONE = 5'd24;
+  // product sinks: bursts of six products of one joint (target or columns, sweep dot, residual
+  // update) and the streams of the preparation over all joints (|Js_j|^2, e_j, y_j, c_j, bounds)
+  // (the target V: M_T; the integration stream: M_X).  Each product carries its sink in its tag,
+  // so a burst or stream can start while the one before still drains.
+  localparam [3:0] M_COL = 4'd0, M_DOT = 4'd1, M_RUPD = 4'd2, M_D = 4'd3, M_E = 4'd4, M_Y = 4'd5,
+                   M_C = 4'd6, M_B = 4'd7, M_T = 4'd8, M_X = 4'd9;
   // multiplier operand selects
   localparam [3:0] A_L = 4'd0, A_JS = 4'd1, A_M = 4'd2, A_Y0 = 4'd3, A_MU = 4'd4, A_KLIM = 4'd5,
                    A_GK = 4'd6, A_QD = 4'd7;
@@ -296,25 +322,21 @@ module ts_core_solve #(
 
   reg [4:0]       state, ret, bret;
   reg [7:0]       wt;
-  reg [1:0]       mode;
-  reg             is_v;          // the column burst scales the target V
+  reg [3:0]       mode;
+  reg [2:0]       rpj;           // stream: products per joint minus one (rows 0..rpj)
+  reg [4:0]       snext;         // stream: state after its drain
+  reg [7:0]       sdrain;        // stream: drain cycles after the last product is issued
   reg [2:0]       bi;            // burst row
   reg [7:0]       bdrain;
   reg [JI_W-1:0]  col;
   reg [JI_W:0]    n_q;
+  reg [JI_W:0]    pj;            // warm-start stream: the joint issued (col leads it)
   reg [SW_W-1:0]  sweep;
   reg [3:0]       asel, bsel;
-  reg [3:0]       tag_q;         // {valid, row} of the product issued this cycle
+  localparam TGW = 8 + JI_W;
+  reg [TGW-1:0]   tag_q;         // {valid, sink, joint, row} of the product issued this cycle
   reg signed [ACW-1:0] acc;
-  reg [MNF:0]     mr_q;          // mantissa m = d 2^-k (MNF + 1 bits, leading one at the top)
-  reg signed [KW-1:0] k_q;
-  reg             dzero;
-  reg signed [RCW-1:0] y0_q;
-  reg signed [RCW-1:0] e_q;
-  reg signed [RCW-1:0] y_q;
   reg signed [PLW-1:0] plo_q, phi_q;
-  reg signed [QD_W-1:0] lo_q, hi_q;
-  reg             lo_pos_q, hi_pos_q;
   reg signed [QD_W-1:0] rb_q;    // residual-update multiplier (q'_i at init, dq in the sweeps)
   reg signed [GXW-1:0] gsh_q;
   reg signed [GKW-1:0] gk_q;
@@ -326,11 +348,13 @@ module ts_core_solve #(
   // ---- shared multiplier -------------------------------------------------------------------------
   // a operands sign-extended to MAW bits
   wire signed [MAW-1:0] a_L, a_js, a_m, a_y0, a_mu, a_klim, a_gk, a_qd;
-  wire signed [JSW-1:0] js_bi = js[{col, bi}];
+  // (the warm-start stream reads its joint's column at pj: col runs ahead there)
+  wire [JI_W-1:0] js_j = (state == S_PW) ? pj[JI_W-1:0] : col;
+  wire signed [JSW-1:0] js_bi = js[{js_j, bi}];
   ts_resize #(.IN_W(LCW), .LSH(0), .OUT_W(MAW)) u_aL (.in(cfg_L), .out(a_L));
   ts_resize #(.IN_W(JSW), .LSH(0), .OUT_W(MAW)) u_ajs (.in(js_bi), .out(a_js));
-  ts_resize #(.IN_W(MNF + 2), .LSH(0), .OUT_W(MAW)) u_am (.in({1'b0, mr_q}), .out(a_m));
-  ts_resize #(.IN_W(RCW), .LSH(0), .OUT_W(MAW)) u_ay0 (.in(y0_q), .out(a_y0));
+  ts_resize #(.IN_W(MNF + 2), .LSH(0), .OUT_W(MAW)) u_am (.in({1'b0, mr_c}), .out(a_m));
+  ts_resize #(.IN_W(RCW), .LSH(0), .OUT_W(MAW)) u_ay0 (.in(y0_c), .out(a_y0));
   ts_resize #(.IN_W(MUW), .LSH(0), .OUT_W(MAW)) u_amu (.in(cl_mu), .out(a_mu));
   ts_resize #(.IN_W(KLW), .LSH(0), .OUT_W(MAW)) u_akl (.in(cfg_klim), .out(a_klim));
   ts_resize #(.IN_W(GKW), .LSH(0), .OUT_W(MAW)) u_agk (.in(gk_q), .out(a_gk));
@@ -344,11 +368,12 @@ module ts_core_solve #(
   ts_resize #(.IN_W(JWW), .LSH(0), .OUT_W(MBW)) u_bjw (.in(x_jw[{col, jrow}]), .out(b_jw));
   ts_resize #(.IN_W(VLW), .LSH(0), .OUT_W(MBW)) u_bvw (.in(x_vw[jrow]), .out(b_vw));
   ts_resize #(.IN_W(JSW), .LSH(0), .OUT_W(MBW)) u_bjs (.in(js_bi), .out(b_js));
-  ts_resize #(.IN_W(EW), .LSH(0), .OUT_W(MBW)) u_be (.in(e_q), .out(b_e));
-  ts_resize #(.IN_W(RCW), .LSH(0), .OUT_W(MBW)) u_by (.in(y_q), .out(b_y));
-  ts_resize #(.IN_W(RCW), .LSH(0), .OUT_W(MBW)) u_by0 (.in(y0_q), .out(b_y0));
-  ts_resize #(.IN_W(QFW), .LSH(0), .OUT_W(MBW)) u_bdlo (.in(dlo), .out(b_dlo));
-  ts_resize #(.IN_W(QFW), .LSH(0), .OUT_W(MBW)) u_bdhi (.in(dhi), .out(b_dhi));
+  // e_j (stream y) and y_j (stream c) are the same memory word, read at col
+  ts_resize #(.IN_W(EW), .LSH(0), .OUT_W(MBW)) u_be (.in(ey_c), .out(b_e));
+  assign b_y = b_e;
+  ts_resize #(.IN_W(RCW), .LSH(0), .OUT_W(MBW)) u_by0 (.in(y0_c), .out(b_y0));
+  ts_resize #(.IN_W(QFW), .LSH(0), .OUT_W(MBW)) u_bdlo (.in(dlo_c), .out(b_dlo));
+  ts_resize #(.IN_W(QFW), .LSH(0), .OUT_W(MBW)) u_bdhi (.in(dhi_c), .out(b_dhi));
   ts_resize #(.IN_W(QD_W), .LSH(0), .OUT_W(MBW)) u_brb (.in(rb_q), .out(b_rb));
   ts_resize #(.IN_W(TW_W), .LSH(0), .OUT_W(MBW)) u_bro (.in(ro_bi), .out(b_ro));
   ts_resize #(.IN_W(STW), .LSH(0), .OUT_W(MBW)) u_bc (.in(cst_c), .out(b_c));
@@ -378,7 +403,7 @@ module ts_core_solve #(
       B_JS:    b_sel = b_js;
       B_E:     b_sel = b_e;
       B_Y:     b_sel = b_y;
-      B_DLO:   b_sel = b_dlo;
+      B_DLO:   b_sel = bi[0] ? b_dhi : b_dlo;    // the bounds stream: row 0 lo - q, row 1 hi - q
       B_DHI:   b_sel = b_dhi;
       B_RB:    b_sel = b_rb;
       B_RO:    b_sel = b_ro;
@@ -388,10 +413,21 @@ module ts_core_solve #(
     endcase
   end
 
-  // product tags: {valid, row} at the product (tag_p) and after a rounder (tag_r)
-  wire [3:0] tag_p, tag_r;
-  ts_delay #(.W(4), .DEPTH(MLAT)) u_tagp (.clk(clk), .rst(rst), .din(tag_q), .dout(tag_p));
-  ts_delay #(.W(4), .DEPTH(RL)) u_tagr (.clk(clk), .rst(rst), .din(tag_p), .dout(tag_r));
+  // product tags: {valid, sink, joint, row} at the product (tag_p) and after a rounder (tag_r)
+  wire [TGW-1:0] tag_p, tag_r;
+  ts_delay #(.W(TGW), .DEPTH(MLAT)) u_tagp (.clk(clk), .rst(rst), .din(tag_q), .dout(tag_p));
+  // (tag_r1: one cycle before tag_r, for reads that are registered into tag_r's cycle)
+  wire [TGW-1:0] tag_r1;
+  ts_delay #(.W(TGW), .DEPTH(RL - 1)) u_tagr1 (.clk(clk), .rst(rst), .din(tag_p), .dout(tag_r1));
+  ts_delay #(.W(TGW), .DEPTH(1)) u_tagr (.clk(clk), .rst(rst), .din(tag_r1), .dout(tag_r));
+  wire [JI_W-1:0] tj_r1 = tag_r1[3 +: JI_W];
+  wire unused_tag_r1 = ^{tag_r1[TGW-1:3 + JI_W], tag_r1[2:0]};
+  wire       tv_p = tag_p[TGW-1];
+  wire       tv_r = tag_r[TGW-1];
+  wire [JI_W-1:0] tj_p = tag_p[3 +: JI_W];
+  wire [JI_W-1:0] tj_r = tag_r[3 +: JI_W];
+  wire [3:0] tm_p = tag_p[3 + JI_W +: 4];
+  wire [3:0] tm_r = tag_r[3 + JI_W +: 4];
   wire [2:0] row_p = tag_p[2:0];
   wire [2:0] row_r = tag_r[2:0];
   wire [1:0] vrow_p = (row_p >= 3'd3) ? (row_p[1:0] - 2'd3) : 2'd0;
@@ -408,7 +444,7 @@ module ts_core_solve #(
   ts_round_sat #(.IN_W(LCW + JWW), .SHIFT(TS_LCHAR_F + TS_JW_F - JSF), .OUT_W(JSW), .SAT(1))
     u_r_jsl (.clk(clk), .rst(rst), .in_x(p_lj), .out_y(jsl_o), .out_sat(jsl_s));
   ts_round_sat #(.IN_W(JVW), .SHIFT(TS_JV_F - JSF), .OUT_W(JSW), .SAT(1))
-    u_r_jsv (.clk(clk), .rst(rst), .in_x(x_jv[{col, vrow_p}]), .out_y(jsv_o), .out_sat(jsv_s));
+    u_r_jsv (.clk(clk), .rst(rst), .in_x(x_jv[{tj_p, vrow_p}]), .out_y(jsv_o), .out_sat(jsv_s));
   ts_round_sat #(.IN_W(LCW + VLW), .SHIFT(TS_LCHAR_F + TS_VEL_F - TWF), .OUT_W(TW_W), .SAT(1))
     u_r_twl (.clk(clk), .rst(rst), .in_x(p_lv), .out_y(twl_o), .out_sat(twl_s));
   ts_round_sat #(.IN_W(VLW), .SHIFT(TS_VEL_F - TWF), .OUT_W(TW_W), .SAT(1))
@@ -425,7 +461,7 @@ module ts_core_solve #(
     u_r_e (.clk(clk), .rst(rst), .in_x(e_in), .out_y(e_o), .out_sat(e_s));
   wire signed [YIW-1:0] p_y, y0_al, y_in;
   ts_resize #(.IN_W(PW), .LSH(0), .OUT_W(YIW)) u_py (.in(p), .out(p_y));
-  ts_resize #(.IN_W(RCW), .LSH(EF), .OUT_W(YIW)) u_y0al (.in(y0_q), .out(y0_al));
+  ts_resize #(.IN_W(RCW), .LSH(EF), .OUT_W(YIW)) u_y0al (.in(y0_p), .out(y0_al));
   assign y_in = y0_al + p_y;
   wire signed [RCW-1:0] y_o;
   wire y_s;
@@ -467,8 +503,8 @@ module ts_core_solve #(
     u_r_phi (.clk(clk), .rst(rst), .in_x(phi_q), .out_y(phi_o), .out_sat(phi_s));
   // exact comparisons of the position bounds with the velocity interval
   wire signed [CMW-1:0] vmin_c, vmax_c, plo_c, phi_c;
-  ts_resize #(.IN_W(QD_W), .LSH(PLF - QDF), .OUT_W(CMW)) u_vminc (.in(vmin_o), .out(vmin_c));
-  ts_resize #(.IN_W(QD_W), .LSH(PLF - QDF), .OUT_W(CMW)) u_vmaxc (.in(cl_vmax), .out(vmax_c));
+  ts_resize #(.IN_W(QD_W), .LSH(PLF - QDF), .OUT_W(CMW)) u_vminc (.in(vmin_b), .out(vmin_c));
+  ts_resize #(.IN_W(QD_W), .LSH(PLF - QDF), .OUT_W(CMW)) u_vmaxc (.in(vmax_b), .out(vmax_c));
   ts_resize #(.IN_W(PLW), .LSH(0), .OUT_W(CMW)) u_ploc (.in(plo_q), .out(plo_c));
   ts_resize #(.IN_W(PLW), .LSH(0), .OUT_W(CMW)) u_phic (.in(phi_q), .out(phi_c));
 
@@ -542,7 +578,7 @@ module ts_core_solve #(
 
   // q_next = cvt<angle_t>(q + q' dt)
   wire signed [NIW-1:0] q_al, p_nal, qx_in;
-  ts_resize #(.IN_W(ANG_W), .LSH(NSF - AF), .OUT_W(NIW)) u_qal (.in(xc_q), .out(q_al));
+  ts_resize #(.IN_W(ANG_W), .LSH(NSF - AF), .OUT_W(NIW)) u_qal (.in(xq_p), .out(q_al));
   ts_resize #(.IN_W(PW), .LSH(NSF - NPF), .OUT_W(NIW)) u_pnal (.in(p), .out(p_nal));
   assign qx_in = q_al + p_nal;
   wire signed [ANG_W-1:0] qx_o;
@@ -550,10 +586,44 @@ module ts_core_solve #(
   ts_round_sat #(.IN_W(NIW), .SHIFT(NSF - AF), .OUT_W(ANG_W), .SAT(1))
     u_r_qx (.clk(clk), .rst(rst), .in_x(qx_in), .out_y(qx_o), .out_sat(qx_s));
 
+  // ---- bound decisions (the bounds stream) ------------------------------------------------------
+  // Stage 0, the cycle after joint bj0's hi product: plo_q and phi_q hold klim (lo - q) and
+  // klim (hi - q) of joint bj0, vmin_b and vmax_b its velocity interval; the exact comparisons.
+  // Stage RL (the rounded cvt<qd_t>(plo), cvt<qd_t>(phi) of u_r_plo / u_r_phi): the choice, written
+  // to u_bnd and blo_pos / bhi_pos (the model's solver_steps bounds).
+  reg             bv0;
+  reg [JI_W-1:0]  bj0;
+  localparam BDW = 1 + JI_W + 5 + 2 * QD_W;
+  wire [BDW-1:0] bd_0 = {bv0, bj0, cfg_lim[bj0], vmin_c < plo_c, vmax_c < plo_c, phi_c < vmax_c,
+                         phi_c < vmin_c, vmax_b, vmin_b};
+  wire [BDW-1:0] bd_2;
+  ts_delay #(.W(BDW), .DEPTH(RL)) u_bd (.clk(clk), .rst(rst), .din(bd_0), .dout(bd_2));
+  wire                   bv2 = bd_2[BDW-1];
+  wire [JI_W-1:0]        bj2 = bd_2[2 * QD_W + 5 +: JI_W];
+  wire                   lim2 = bd_2[2 * QD_W + 4];
+  wire                   lo_c2 = bd_2[2 * QD_W + 3];    // vmin < plo: a position bound below
+  wire                   lo_v2 = bd_2[2 * QD_W + 2];    // vmax < plo
+  wire                   hi_c2 = bd_2[2 * QD_W + 1];    // phi < vmax: a position bound above
+  wire                   hi_v2 = bd_2[2 * QD_W];        // phi < vmin
+  wire signed [QD_W-1:0] vmax2 = bd_2[QD_W +: QD_W];
+  wire signed [QD_W-1:0] vmin2 = bd_2[0 +: QD_W];
+  wire                   lo_pos2 = lim2 && lo_c2;
+  wire                   hi_pos2 = lim2 && hi_c2;
+  wire signed [QD_W-1:0] lo2 = !lo_pos2 ? vmin2 : (lo_v2 ? vmax2 : plo_o);
+  wire signed [QD_W-1:0] hi2 = !hi_pos2 ? vmax2 : (hi_v2 ? vmin2 : phi_o);
+  wire                   bsat2 = (lo_pos2 && !lo_v2 && plo_s) || (hi_pos2 && !hi_v2 && phi_s);
+
   // ---- combinational helpers -------------------------------------------------------------------
-  // leading one of d = |Js_i|^2 (>= 0) and the normalised mantissa
-  wire [DW-1:0] dval;
-  ts_resize #(.IN_W(ACW), .LSH(0), .OUT_W(DW)) u_dv (.in(acc), .out(dval));
+  // leading one of d = |Js_j|^2 (>= 0) and the normalised mantissa, a pipeline behind the |Js_j|^2
+  // stream: d_q (the sum, at its last product), then (N1) the leading one and the shift, (N2) the
+  // mantissa, k and d = 0, (N3) the reciprocal seed, written to u_nrm at the joint
+  reg  [DW-1:0]   d_q, d1_q;
+  reg  [JI_W-1:0] dj_q, dj1_q, dj2_q;
+  reg             dv_q, dv1_q, dv2_q;
+  reg  [MNF:0]    mr2_q;
+  reg  signed [KW-1:0] k2_q;
+  reg             dz2_q;
+  wire [DW-1:0] dval = d_q;
   // in two levels (the leading one of each 8-bit group, then the highest non-empty group): two
   // short priority chains instead of one DW long (the engine's critical path after the register
   // changes above)
@@ -574,99 +644,135 @@ module ts_core_solve #(
     for (gg = 0; gg < NG; gg = gg + 1)
       if (gany[gg]) msb = {gg[3:0], gmsb[gg*3 +: 3]};
   end
-  // The leading one and the shift registered every cycle (msb_q, lsh_q): the dot burst drains one
-  // cycle longer (S_DOTD), so at S_NORM they belong to the final d, and the detector and the
-  // subtraction leave the path through the shifter into mr_q (priority chain, subtraction and
-  // shifter in one cycle were the solver's critical path, 14.7 ns post-route on LFE5U-85F -6).
+  // The leading one and the shift are registered (N1), so the detector and the subtraction leave
+  // the path through the shifter (priority chain, subtraction and shifter in one cycle were the
+  // solver's critical path, 14.7 ns post-route on LFE5U-85F -6).
   reg  [6:0] msb_q, lsh_q;
-  always @(posedge clk) begin
-    msb_q <= msb;
-    lsh_q <= 7'd0 + (DW - 1) - msb;
-  end
-  wire [DW-1:0] dn = dval << lsh_q;
+  wire [DW-1:0] dn = d1_q << lsh_q;
   wire unused_dn = ^dn[DW-MNF-2:0];
   wire signed [KW-1:0] k_new = $signed({1'b0, msb_q}) - DPF_K;
 
   // reciprocal seed table
   (* rom_style = "logic" *) reg [RCW-1:0] rom [0:(1 << T)-1];
   initial $readmemh(ROM_FILE, rom);
+  wire [RCW-1:0] y0_new = rom[mr2_q[MNF-1 -: T]];
 
+  always @(posedge clk) begin
+    if (rst) begin
+      d1_q <= {DW{1'b0}}; dj1_q <= {JI_W{1'b0}}; dj2_q <= {JI_W{1'b0}}; dv1_q <= 1'b0; dv2_q <= 1'b0;
+      msb_q <= 7'd0; lsh_q <= 7'd0; mr2_q <= {(MNF + 1){1'b0}}; k2_q <= {KW{1'b0}}; dz2_q <= 1'b0;
+    end else begin
+      // N1
+      msb_q <= msb;
+      lsh_q <= 7'd0 + (DW - 1) - msb;
+      d1_q <= d_q; dj1_q <= dj_q; dv1_q <= dv_q;
+      // N2
+      mr2_q <= dn[DW-1 -: MNF + 1];
+      k2_q <= k_new;
+      dz2_q <= (d1_q == {DW{1'b0}});
+      dj2_q <= dj1_q; dv2_q <= dv1_q;
+    end
+  end
+
+  // joint col's bounds registered every cycle (col is stable through a step of the sweeps; the warm
+  // start stream sets col two cycles before it needs the joint's q')
+  reg  signed [QD_W-1:0] blo_cq, bhi_cq;
+  always @(posedge clk) begin
+    blo_cq <= blo_c;
+    bhi_cq <= bhi_c;
+  end
   // warm start with its leak, clamped into this tick's box.  The leaked value is registered every
-  // cycle (warm_lq): S_WARM follows S_BND3 with the same col, so it sees joint col's value one
-  // cycle old, and the variable-index read, the shift and the subtraction leave the path into
-  // qd[col] (no cycle added).
+  // cycle (warm_lq), as are the bounds: warm_c is joint col's q' of the cycle before.
   wire signed [QD_W-1:0] warm_x = xc_warm;
   wire signed [QD_W-1:0] warm_sh = warm_x >>> cfg_leak;
   wire signed [QD_W-1:0] warm_l = (cfg_leak == 5'd0) ? warm_x : (warm_x - warm_sh);
   reg  signed [QD_W-1:0] warm_lq;
   always @(posedge clk) warm_lq <= warm_l;
   wire signed [QD_W-1:0] warm_c;
-  ts_clamp #(.W(QD_W)) u_warm_c (.in_x(warm_lq), .in_lo(lo_q), .in_hi(hi_q), .out_y(warm_c));
-  // sweep step clamp; joint col's bounds registered every cycle (col is stable through a step)
-  reg  signed [QD_W-1:0] blo_cq, bhi_cq;
-  always @(posedge clk) begin
-    blo_cq <= blo_c;
-    bhi_cq <= bhi_c;
-  end
+  ts_clamp #(.W(QD_W)) u_warm_c (.in_x(warm_lq), .in_lo(blo_cq), .in_hi(bhi_cq), .out_y(warm_c));
+  // sweep step clamp
   wire signed [QD_W-1:0] qn_c;
   ts_clamp #(.W(QD_W)) u_qn_c (.in_x(qn_o), .in_lo(blo_cq), .in_hi(bhi_cq), .out_y(qn_c));
-  // integration clamp; joint col's limits registered every cycle (S_QNX2 follows S_WAIT with the
-  // same col), so the variable-index reads leave the path into qnext[col] (no cycle added)
+  // integration clamp of the stream's joint tj_r: its limits read a cycle before (at tj_r1) and
+  // registered, so the memory reads leave the path into qnext (q_next = clamp(cvt(q + q' dt)))
   reg  signed [ANG_W-1:0] lo_cq, hi_cq;
   reg                     lim_cq;
   always @(posedge clk) begin
-    lo_cq <= cl_lo;
-    hi_cq <= cl_hi;
-    lim_cq <= cfg_lim[col];
+    lo_cq <= lo_r1;
+    hi_cq <= hi_r1;
+    lim_cq <= cfg_lim[tj_r1];
   end
   wire signed [ANG_W-1:0] qx_c;
   ts_clamp #(.W(ANG_W)) u_qx_c (.in_x(qx_o), .in_lo(lo_cq), .in_hi(hi_cq), .out_y(qx_c));
-  // active-limit flags of joint col
-  wire lo_hit = !(blo_c < qd[col]);
-  wire hi_hit = !(qd[col] < bhi_c);
-  wire lim_act = (blo_pos[col] && lo_hit) || (bhi_pos[col] && hi_hit);
-  wire vlim_act = ((!blo_pos[col] && lo_hit) || (!bhi_pos[col] && hi_hit))
-                  && (cl_vmax != {1'b0, {(QD_W - 1){1'b1}}});
+  // active-limit flags of joint tj_r (its final q' against its bounds)
+  wire lo_hit = !(blo_r < qd[tj_r]);
+  wire hi_hit = !(qd[tj_r] < bhi_r);
+  wire lim_act = (blo_pos[tj_r] && lo_hit) || (bhi_pos[tj_r] && hi_hit);
+  wire vlim_act = ((!blo_pos[tj_r] && lo_hit) || (!bhi_pos[tj_r] && hi_hit))
+                  && (vmax_r != {1'b0, {(QD_W - 1){1'b1}}});
 
   wire last_col = ({1'b0, col} == n_q - 1'b1);
   wire signed [ACW-1:0] p_acc;
   ts_resize #(.IN_W(PW), .LSH(0), .OUT_W(ACW)) u_pacc (.in(p), .out(p_acc));
 
   // ---- per-joint memories (ts_ram: distributed RAM on ECP5, no reset) -------------------------------
-  // configuration and inputs as written; c and k of joint col at S_C (or S_NORM2), its bounds at
-  // S_WARM
+  // configuration and inputs as written; the preparation streams' words at their sinks
   wire cfg_jwe = in_cfg_we && !cfg_g && !rst;
   wire x_jwe = in_x_we && !x_g && !rst;
-  ts_ram #(.W(ANG_W), .AW(JI_W), .R(1)) u_cfg_lo (.clk(clk), .in_we(cfg_jwe && (cfg_f == 4'd0)),
-    .in_waddr(cfg_j), .in_wdata(in_cfg_data[ANG_W-1:0]), .in_raddr(col), .out_rdata(cl_lo));
-  ts_ram #(.W(ANG_W), .AW(JI_W), .R(1)) u_cfg_hi (.clk(clk), .in_we(cfg_jwe && (cfg_f == 4'd1)),
-    .in_waddr(cfg_j), .in_wdata(in_cfg_data[ANG_W-1:0]), .in_raddr(col), .out_rdata(cl_hi));
-  ts_ram #(.W(QD_W), .AW(JI_W), .R(1)) u_cfg_vmax (.clk(clk), .in_we(cfg_jwe && (cfg_f == 4'd2)),
-    .in_waddr(cfg_j), .in_wdata(in_cfg_data[QD_W-1:0]), .in_raddr(col), .out_rdata(cl_vmax));
+  ts_ram #(.W(ANG_W), .AW(JI_W), .R(2)) u_cfg_lo (.clk(clk), .in_we(cfg_jwe && (cfg_f == 4'd0)),
+    .in_waddr(cfg_j), .in_wdata(in_cfg_data[ANG_W-1:0]), .in_raddr({tj_r1, col}), .out_rdata({lo_r1, cl_lo}));
+  ts_ram #(.W(ANG_W), .AW(JI_W), .R(2)) u_cfg_hi (.clk(clk), .in_we(cfg_jwe && (cfg_f == 4'd1)),
+    .in_waddr(cfg_j), .in_wdata(in_cfg_data[ANG_W-1:0]), .in_raddr({tj_r1, col}), .out_rdata({hi_r1, cl_hi}));
+  ts_ram #(.W(QD_W), .AW(JI_W), .R(3)) u_cfg_vmax (.clk(clk), .in_we(cfg_jwe && (cfg_f == 4'd2)),
+    .in_waddr(cfg_j), .in_wdata(in_cfg_data[QD_W-1:0]), .in_raddr({tj_r, bj0, col}),
+    .out_rdata({vmax_r, vmax_b, cl_vmax}));
   ts_ram #(.W(MUW), .AW(JI_W), .R(1)) u_cfg_mu (.clk(clk), .in_we(cfg_jwe && (cfg_f == 4'd3)),
     .in_waddr(cfg_j), .in_wdata(in_cfg_data[MUW-1:0]), .in_raddr(col), .out_rdata(cl_mu));
-  ts_ram #(.W(ANG_W), .AW(JI_W), .R(1)) u_x_q (.clk(clk), .in_we(x_jwe && (x_f == 4'd6)),
-    .in_waddr(x_j), .in_wdata(in_x_data[ANG_W-1:0]), .in_raddr(col), .out_rdata(xc_q));
+  ts_ram #(.W(ANG_W), .AW(JI_W), .R(2)) u_x_q (.clk(clk), .in_we(x_jwe && (x_f == 4'd6)),
+    .in_waddr(x_j), .in_wdata(in_x_data[ANG_W-1:0]), .in_raddr({tj_p, col}), .out_rdata({xq_p, xc_q}));
   ts_ram #(.W(QD_W), .AW(JI_W), .R(1)) u_x_warm (.clk(clk), .in_we(x_jwe && (x_f == 4'd7)),
     .in_waddr(x_j), .in_wdata(in_x_data[QD_W-1:0]), .in_raddr(col), .out_rdata(xc_warm));
-  // (c, k of a zero column, |Js_col|^2 = 0: both 0, written at S_NORM2)
-  wire ck_zero = (state == S_NORM2) && dzero;
-  ts_ram #(.W(STW + KW), .AW(JI_W), .R(1)) u_ck (.clk(clk), .in_we(((state == S_C) || ck_zero) && !rst),
-    .in_waddr(col), .in_wdata(ck_zero ? {(STW + KW){1'b0}} : {c_o, k_q}), .in_raddr(col),
+  // the preparation streams' per-joint words (see their declarations); a zero column (|Js_j|^2 = 0)
+  // gets c = k = 0
+  ts_ram #(.W(NRW), .AW(JI_W), .R(3)) u_nrm (.clk(clk), .in_we(dv2_q && !rst), .in_waddr(dj2_q),
+    .in_wdata({dz2_q, k2_q, mr2_q, y0_new}), .in_raddr({tj_r, tj_p, col}), .out_rdata({nrm_r, nrm_p, nrm_c}));
+  ts_ram #(.W(RCW), .AW(JI_W), .R(1)) u_ey (.clk(clk),
+    .in_we(tv_r && ((tm_r == M_E) || (tm_r == M_Y)) && !rst), .in_waddr(tj_r),
+    .in_wdata((tm_r == M_E) ? e_o : y_o), .in_raddr(col), .out_rdata(ey_c));
+  // the position differences and vmin of joint col, from their rounders in the columns stream
+  // (col holds for the six rows of a joint; the rounders' outputs are joint col's from row RL on)
+  wire dd_we = (state == S_STREAM) && (mode == M_COL) && (bi == 3'd5);
+  ts_ram #(.W(DDW), .AW(JI_W), .R(2)) u_dd (.clk(clk), .in_we(dd_we && !rst), .in_waddr(col),
+    .in_wdata({vmin_o, dhi, dlo}), .in_raddr({bj0, col}), .out_rdata({dd_b, dd_c}));
+  ts_ram #(.W(STW + KW), .AW(JI_W), .R(1)) u_ck (.clk(clk), .in_we(tv_r && (tm_r == M_C) && !rst),
+    .in_waddr(tj_r), .in_wdata(dz_r ? {(STW + KW){1'b0}} : {c_o, k_r}), .in_raddr(col),
     .out_rdata({cst_c, kst_c}));
-  ts_ram #(.W(2 * QD_W), .AW(JI_W), .R(1)) u_bnd (.clk(clk), .in_we((state == S_WARM) && !rst),
-    .in_waddr(col), .in_wdata({hi_q, lo_q}), .in_raddr(col), .out_rdata({bhi_c, blo_c}));
+  ts_ram #(.W(2 * QD_W), .AW(JI_W), .R(2)) u_bnd (.clk(clk), .in_we(bv2 && !rst),
+    .in_waddr(bj2), .in_wdata({hi2, lo2}), .in_raddr({tj_r, col}), .out_rdata({bhi_r, blo_r, bhi_c, blo_c}));
 
   // ---- sequencer -----------------------------------------------------------------------------------
+  // d = |Js_j|^2 at the last product of joint j's |Js_j|^2 stream
+  wire signed [ACW-1:0] acc_sum = acc + p_acc;
+  wire [DW-1:0] d_sum;
+  ts_resize #(.IN_W(ACW), .LSH(0), .OUT_W(DW)) u_dv (.in(acc_sum), .out(d_sum));
+  localparam [7:0] RL8 = RL[7:0];
+  // A coordinate step's residual update and the next step's dot overlap: the dot's row a is issued
+  // once cvt<tw_t>(racc[a]) holds the update of row a (MLAT + 2 RL + 2 cycles after that row's
+  // update was issued: product, racc rounder, racc, ro rounder; the rows follow one per cycle on
+  // both sides).  The update burst drains UW8 cycles, then S_NEXTJ and S_SWEEP, then the dot's
+  // first row.
+  localparam integer UWI = (MLAT + 2 * RL - 7 > 0) ? (MLAT + 2 * RL - 7) : 0;
+  localparam [7:0] UW8 = UWI[7:0];
+
   always @(posedge clk) begin
     if (rst) begin
-      state <= S_IDLE; ret <= S_IDLE; bret <= S_IDLE; wt <= 8'd0; mode <= M_COL; is_v <= 1'b0;
+      state <= S_IDLE; ret <= S_IDLE; bret <= S_IDLE; wt <= 8'd0; mode <= M_COL;
       bi <= 3'd0; bdrain <= 8'd0; col <= {JI_W{1'b0}}; n_q <= {(JI_W + 1){1'b0}}; sweep <= {SW_W{1'b0}};
-      asel <= A_L; bsel <= B_JW; tag_q <= 4'd0; mul_a <= {MAW{1'b0}}; mul_b <= {MBW{1'b0}};
-      acc <= {ACW{1'b0}}; mr_q <= {(MNF + 1){1'b0}}; k_q <= {KW{1'b0}}; dzero <= 1'b0;
-      y0_q <= {RCW{1'b0}}; e_q <= {RCW{1'b0}}; y_q <= {RCW{1'b0}};
-      plo_q <= {PLW{1'b0}}; phi_q <= {PLW{1'b0}}; lo_q <= {QD_W{1'b0}}; hi_q <= {QD_W{1'b0}};
-      lo_pos_q <= 1'b0; hi_pos_q <= 1'b0; rb_q <= {QD_W{1'b0}}; gsh_q <= {GXW{1'b0}}; gk_q <= {GKW{1'b0}};
+      rpj <= 3'd0; snext <= S_IDLE; sdrain <= 8'd0; pj <= {(JI_W + 1){1'b0}};
+      asel <= A_L; bsel <= B_JW; tag_q <= {TGW{1'b0}}; mul_a <= {MAW{1'b0}}; mul_b <= {MBW{1'b0}};
+      acc <= {ACW{1'b0}}; d_q <= {DW{1'b0}}; dj_q <= {JI_W{1'b0}}; dv_q <= 1'b0;
+      bv0 <= 1'b0; bj0 <= {JI_W{1'b0}}; plo_q <= {PLW{1'b0}}; phi_q <= {PLW{1'b0}};
+      rb_q <= {QD_W{1'b0}}; gsh_q <= {GXW{1'b0}}; gk_q <= {GKW{1'b0}};
       qnc_q <= {QD_W{1'b0}}; flags <= 32'd0;
       out_busy <= 1'b0; out_done <= 1'b0; out_r <= {(6 * TW_W){1'b0}}; out_flags <= 32'd0;
       for (ri = 0; ri < NMAX; ri = ri + 1) begin
@@ -677,24 +783,53 @@ module ts_core_solve #(
       end
     end else begin
       out_done <= 1'b0;
-      tag_q <= 4'd0;
+      tag_q <= {TGW{1'b0}};
       mul_a <= a_sel;
       mul_b <= b_sel;
+      dv_q <= 1'b0;
+      bv0 <= 1'b0;
 
-      // burst sinks
-      if (tag_p[3] && (mode == M_DOT)) acc <= acc + p_acc;
-      if (tag_r[3] && (mode == M_COL)) begin
-        if (is_v) begin
+      // sinks of the bursts and streams (the mode of a burst or stream holds until its last
+      // product has drained)
+      if (tv_p && (tm_p == M_DOT)) acc <= acc_sum;
+      if (tv_p && (tm_p == M_D)) begin
+        acc <= (row_p == 3'd0) ? p_acc : acc_sum;
+        if (row_p == 3'd5) begin
+          d_q <= d_sum; dj_q <= tj_p; dv_q <= 1'b1;
+        end
+      end
+      if (tv_p && (tm_p == M_B)) begin
+        if (row_p == 3'd0) plo_q <= p_pl;
+        else begin
+          phi_q <= p_pl; bj0 <= tj_p; bv0 <= 1'b1;
+        end
+      end
+      if (tv_r && ((tm_r == M_COL) || (tm_r == M_T))) begin
+        if (tm_r == M_T) begin
           vs[row_r] <= (row_r < 3'd3) ? twl_o : twv_o;
           if ((row_r < 3'd3) ? twl_s : twv_s) flags[8] <= 1'b1;
         end else begin
-          js[{col, row_r}] <= (row_r < 3'd3) ? jsl_o : jsv_o;
+          js[{tj_r, row_r}] <= (row_r < 3'd3) ? jsl_o : jsv_o;
           if ((row_r < 3'd3) ? jsl_s : jsv_s) flags[8] <= 1'b1;
         end
       end
-      if (tag_r[3] && (mode == M_RUPD)) begin
+      if (tv_r && (tm_r == M_RUPD)) begin
         racc[row_r] <= racc_o;
         if (racc_s) flags[8] <= 1'b1;
+      end
+      // e, y, c of a zero column are not used (c = k = 0): their saturation is not the model's
+      if (tv_r && !dz_r && (((tm_r == M_E) && e_s) || ((tm_r == M_Y) && y_s) || ((tm_r == M_C) && c_s)))
+        flags[8] <= 1'b1;
+      if (dd_we && (vmin_s || (cfg_lim[col] && (dlo_s || dhi_s)))) flags[8] <= 1'b1;
+      if (tv_r && (tm_r == M_X)) begin
+        qnext[tj_r] <= lim_cq ? qx_c : qx_o;
+        if (qx_s) flags[0] <= 1'b1;
+        if (lim_act) flags[16] <= 1'b1;
+        if (vlim_act) flags[17] <= 1'b1;
+      end
+      if (bv2) begin
+        blo_pos[bj2] <= lo_pos2; bhi_pos[bj2] <= hi_pos2;
+        if (bsat2) flags[8] <= 1'b1;
       end
 
       case (state)
@@ -705,8 +840,7 @@ module ts_core_solve #(
             n_q <= in_n;
             col <= {JI_W{1'b0}};
             // target: L V_w and V_v
-            is_v <= 1'b1;
-            mode <= M_COL; asel <= A_L; bsel <= B_VW; bi <= 3'd0; bdrain <= ML8 + 8'd2;
+            mode <= M_T; asel <= A_L; bsel <= B_VW; bi <= 3'd0; bdrain <= ML8 + 8'd2;
             bret <= S_RINIT;
             state <= S_ISSUE;
           end
@@ -716,9 +850,11 @@ module ts_core_solve #(
           else wt <= wt - 1'b1;
         end
         S_ISSUE: begin
-          // operands of row bi are registered into the multiplier this cycle
-          tag_q <= {1'b1, bi};
+          // operands of row bi of joint col are registered into the multiplier this cycle
+          tag_q <= {1'b1, mode, col, bi};
           if ((mode == M_DOT) && (bi == 3'd0)) acc <= {ACW{1'b0}};
+          // the dot's operand cvt<tw_t>(racc[bi]) (saturation flagged as the model's solver_run)
+          if ((mode == M_DOT) && ro_s[bi]) flags[8] <= 1'b1;
           if (bi == 3'd5) begin
             bi <= 3'd0;
             wt <= bdrain;
@@ -728,123 +864,85 @@ module ts_core_solve #(
             bi <= bi + 1'b1;
           end
         end
+        S_STREAM: begin
+          // a preparation stream: products 0..rpj of every joint on consecutive cycles, then the
+          // drain of sdrain cycles and snext
+          tag_q <= {1'b1, mode, col, bi};
+          if (bi == rpj) begin
+            bi <= 3'd0;
+            if (last_col) begin
+              wt <= sdrain;
+              ret <= snext;
+              state <= S_WAIT;
+            end else col <= col + 1'b1;
+          end else bi <= bi + 1'b1;
+        end
         S_RINIT: begin
           for (ri = 0; ri < 6; ri = ri + 1) racc[ri] <= vs_al[ri*TAW +: TAW];
-          is_v <= 1'b0;
-          state <= S_COL;
+          // the scaled columns (the position differences and vmin of each joint on the way, dd_we)
+          mode <= M_COL; asel <= A_L; bsel <= B_JW; col <= {JI_W{1'b0}}; bi <= 3'd0; rpj <= 3'd5;
+          sdrain <= ML8 + RL8; snext <= S_PD;
+          state <= S_STREAM;
         end
-        S_COL: begin
-          // scaled column col
-          mode <= M_COL; asel <= A_L; bsel <= B_JW; bi <= 3'd0; bdrain <= ML8 + 8'd2;
-          bret <= S_DOTD;
-          state <= S_ISSUE;
+        S_PD: begin
+          // |Js_j|^2, normalised and the seed looked up behind the stream (N1-N3)
+          mode <= M_D; asel <= A_JS; bsel <= B_JS; col <= {JI_W{1'b0}}; bi <= 3'd0; rpj <= 3'd5;
+          sdrain <= ML8 + 8'd3; snext <= S_PE;
+          state <= S_STREAM;
         end
-        S_DOTD: begin
-          mode <= M_DOT; asel <= A_JS; bsel <= B_JS; bi <= 3'd0; bdrain <= ML8 + 8'd1;   // + msb_q
-          bret <= S_NORM;
-          state <= S_ISSUE;
+        S_PE: begin
+          // e = cvt<e_t>(1 - m y0)
+          mode <= M_E; asel <= A_M; bsel <= B_Y0; col <= {JI_W{1'b0}}; bi <= 3'd0; rpj <= 3'd0;
+          sdrain <= ML8 + RL8; snext <= S_PY;
+          state <= S_STREAM;
         end
-        S_NORM: begin
-          mr_q <= dn[DW-1 -: MNF + 1];
-          k_q <= k_new;
-          dzero <= (dval == {DW{1'b0}});
-          state <= S_NORM2;
+        S_PY: begin
+          // y = cvt<recip_t>(y0 + y0 e)
+          mode <= M_Y; asel <= A_Y0; bsel <= B_E; col <= {JI_W{1'b0}}; bi <= 3'd0; rpj <= 3'd0;
+          sdrain <= ML8 + RL8; snext <= S_PC;
+          state <= S_STREAM;
         end
-        S_NORM2: begin
-          y0_q <= rom[mr_q[MNF-1 -: T]];
-          if (dzero) begin
-            // c = k = 0 (written to u_ck in this state)
-            state <= S_BND0;
-          end else begin
-            // m y0 (operands registered in the next cycle, when y0_q holds the seed)
-            asel <= A_M; bsel <= B_Y0;
-            wt <= ML8 + 8'd1 + 8'd1;
-            ret <= S_E;
-            state <= S_WAIT;
-          end
+        S_PC: begin
+          // c = cvt<step_t>(mu y), with k into u_ck
+          mode <= M_C; asel <= A_MU; bsel <= B_Y; col <= {JI_W{1'b0}}; bi <= 3'd0; rpj <= 3'd0;
+          sdrain <= ML8 + RL8; snext <= S_PB;
+          state <= S_STREAM;
         end
-        S_E: begin
-          e_q <= e_o;
-          if (e_s) flags[8] <= 1'b1;
-          asel <= A_Y0; bsel <= B_E;
-          wt <= ML8 + 8'd2;
-          ret <= S_Y;
-          state <= S_WAIT;
+        S_PB: begin
+          // klim (lo - q) (row 0) and klim (hi - q) (row 1), the decisions behind the stream
+          mode <= M_B; asel <= A_KLIM; bsel <= B_DLO; col <= {JI_W{1'b0}}; bi <= 3'd0; rpj <= 3'd1;
+          sdrain <= ML8 + RL8 + 8'd1; snext <= S_PW0;
+          state <= S_STREAM;
         end
-        S_Y: begin
-          y_q <= y_o;
-          if (y_s) flags[8] <= 1'b1;
-          asel <= A_MU; bsel <= B_Y;
-          wt <= ML8 + 8'd2;
-          ret <= S_C;
-          state <= S_WAIT;
+        S_PW0: begin
+          // warm start and racc -= Js_j q'_j: col runs two cycles ahead of the joint issued
+          mode <= M_RUPD; asel <= A_JS; bsel <= B_RB; col <= {JI_W{1'b0}};
+          state <= S_PW1;
         end
-        S_C: begin
-          if (c_s) flags[8] <= 1'b1;
-          state <= S_BND0;
-        end
-        S_BND0: begin
-          // vmin, qdiff rounders have had their inputs since the column started
-          if (vmin_s) flags[8] <= 1'b1;
-          if (cfg_lim[col] && (dlo_s || dhi_s)) flags[8] <= 1'b1;
-          asel <= A_KLIM; bsel <= B_DLO;
-          wt <= ML8;
-          ret <= S_BND1;
-          state <= S_WAIT;
-        end
-        S_BND1: begin
-          plo_q <= p_pl;
-          bsel <= B_DHI;
-          wt <= ML8;
-          ret <= S_BND2;
-          state <= S_WAIT;
-        end
-        S_BND2: begin
-          phi_q <= p_pl;
-          wt <= 8'd2;
-          ret <= S_BND3;
-          state <= S_WAIT;
-        end
-        S_BND3: begin
-          lo_q <= vmin_o; hi_q <= cl_vmax; lo_pos_q <= 1'b0; hi_pos_q <= 1'b0;
-          if (cfg_lim[col]) begin
-            if (vmin_c < plo_c) begin
-              lo_pos_q <= 1'b1;
-              if (vmax_c < plo_c) lo_q <= cl_vmax;
-              else begin
-                lo_q <= plo_o;
-                if (plo_s) flags[8] <= 1'b1;
-              end
-            end
-            if (phi_c < vmax_c) begin
-              hi_pos_q <= 1'b1;
-              if (phi_c < vmin_c) hi_q <= vmin_o;
-              else begin
-                hi_q <= phi_o;
-                if (phi_s) flags[8] <= 1'b1;
-              end
-            end
-          end
-          state <= S_WARM;
-        end
-        S_WARM: begin
-          blo_pos[col] <= lo_pos_q; bhi_pos[col] <= hi_pos_q;
+        S_PW1: state <= S_PW2;
+        S_PW2: begin
           qd[col] <= warm_c;
           rb_q <= warm_c;
-          // racc -= Js_col q'_col
-          mode <= M_RUPD; asel <= A_JS; bsel <= B_RB; bi <= 3'd0; bdrain <= ML8 + 8'd4;
-          bret <= S_COLNEXT;
-          state <= S_ISSUE;
+          pj <= {(JI_W + 1){1'b0}}; bi <= 3'd0;
+          state <= S_PW;
         end
-        S_COLNEXT: begin
-          if (last_col) begin
-            col <= {JI_W{1'b0}};
-            sweep <= {SW_W{1'b0}};
-            state <= S_SWEEP;
-          end else begin
-            col <= col + 1'b1;
-            state <= S_COL;
-          end
+        S_PW: begin
+          tag_q <= {1'b1, mode, pj[JI_W-1:0], bi};
+          if ((bi == 3'd3) && (pj + 1'b1 != n_q)) col <= col + 1'b1;
+          if (bi == 3'd5) begin
+            bi <= 3'd0;
+            if (pj + 1'b1 == n_q) begin
+              col <= {JI_W{1'b0}};
+              sweep <= {SW_W{1'b0}};
+              wt <= ML8 + RL8 + 8'd2;
+              ret <= S_SWEEP;
+              state <= S_WAIT;
+            end else begin
+              pj <= pj + 1'b1;
+              qd[col] <= warm_c;
+              rb_q <= warm_c;
+            end
+          end else bi <= bi + 1'b1;
         end
         S_SWEEP: begin
           // one coordinate step of joint col: g = <Js_col, cvt<tw_t>(racc)>
@@ -852,7 +950,6 @@ module ts_core_solve #(
             col <= {JI_W{1'b0}};
             state <= S_QNX;
           end else begin
-            if (|ro_s) flags[8] <= 1'b1;
             mode <= M_DOT; asel <= A_JS; bsel <= B_RO; bi <= 3'd0; bdrain <= ML8;
             bret <= S_GSH;
             state <= S_ISSUE;
@@ -883,7 +980,7 @@ module ts_core_solve #(
           if (dq_s) flags[8] <= 1'b1;
           rb_q <= dq_o;
           qd[col] <= qnc_q;
-          mode <= M_RUPD; asel <= A_JS; bsel <= B_RB; bi <= 3'd0; bdrain <= ML8 + 8'd4;
+          mode <= M_RUPD; asel <= A_JS; bsel <= B_RB; bi <= 3'd0; bdrain <= UW8;
           bret <= S_NEXTJ;
           state <= S_ISSUE;
         end
@@ -897,22 +994,11 @@ module ts_core_solve #(
           state <= S_SWEEP;
         end
         S_QNX: begin
-          // q_next = clamp(cvt<angle_t>(q + q' dt)) and the active-limit flags of joint col
-          asel <= A_QD; bsel <= B_DT;
-          wt <= ML8 + 8'd2;
-          ret <= S_QNX2;
-          state <= S_WAIT;
-        end
-        S_QNX2: begin
-          qnext[col] <= lim_cq ? qx_c : qx_o;
-          if (qx_s) flags[0] <= 1'b1;
-          if (lim_act) flags[16] <= 1'b1;
-          if (vlim_act) flags[17] <= 1'b1;
-          if (last_col) state <= S_DONE;
-          else begin
-            col <= col + 1'b1;
-            state <= S_QNX;
-          end
+          // the integration stream: q' dt of every joint, q_next and the active-limit flags at
+          // the rounded product (M_X sink)
+          mode <= M_X; asel <= A_QD; bsel <= B_DT; col <= {JI_W{1'b0}}; bi <= 3'd0; rpj <= 3'd0;
+          sdrain <= ML8 + RL8; snext <= S_DONE;
+          state <= S_STREAM;
         end
         S_DONE: begin
           out_r <= ro_f;
@@ -933,6 +1019,7 @@ module ts_core_solve #(
       assign out_q_next[gr*ANG_W +: ANG_W] = qnext[gr];
     end
   endgenerate
+
 
 endmodule
 

@@ -10,7 +10,8 @@ Cases (fresh random, seed printed; replay with TS_SEED=<seed>; TS_NCASE scales t
     of chain20, with different L, klim, sweeps (1, 2, 3, 10), mu (0, 1, 1.9, random), warm_leak;
   - joints at, near and beyond their limits, zero (singular) columns, saturating V and warm start.
 TS_NMAX=<N> builds the module with NMAX = N (default 8; the chain20 cases then use min(N, 20) joints).
-Also: no output is X after reset, the busy/done protocol, the cycles per solve (logged), and that the
+Also: no output is X after reset, the busy/done protocol, the cycles per solve (equal to the
+documented count, whatever the data), and that the
 format localparams of the module equal the model's formats.
 """
 import json
@@ -222,6 +223,19 @@ def x_words(J, V, q, warm) -> list[tuple[int, int]]:
     return words
 
 
+def solve_cycles(cfg: str, n: int, sweeps: int) -> int:
+    """Cycles per solve, as docs/rtl/ts_core_solve.md states them: MLAT is the shared multiplier's
+    latency (operands as wide as the widest a and b operand of the configuration), every joint
+    costs 24 cycles of preparation streams and integration, every coordinate step 3 MLAT + 24;
+    independent of the data (zero columns, limits)."""
+    wa = max(rtlparams.fmt(cfg, t)[0] for t in ("lchar_t", "jsc_t", "mant_t", "recip_t", "mu_t", "klim_t",
+                                                  "gk_t", "qd_t"))
+    wb = max(rtlparams.fmt(cfg, t)[0] for t in ("jw_t", "vel_t", "jsc_t", "recip_t", "qdiff_t", "qd_t",
+                                                  "tw_t", "step_t", "dt_t"))
+    mlat = rtlparams.mul_lat(wa, wb)
+    return 50 + 9 * mlat + 24 * n + sweeps * n * (3 * mlat + 24)
+
+
 if cocotb is not None:
     async def clock_cycles(dut, n):
         from cocotb.triggers import FallingEdge
@@ -293,6 +307,8 @@ if cocotb is not None:
                 k = int(round((get_sim_time("ns") - t0) / 10))
                 assert int(dut.out_busy.value) == 0 and int(dut.out_done.value) == 1
                 cycles.setdefault((n, int(pr["sweeps"])), set()).add(k)
+                if k != solve_cycles(cfg, n, int(pr["sweeps"])):
+                    problems.append(f"{gname} case {ci}: {k} cycles, documented {solve_cycles(cfg, n, int(pr['sweeps']))}")
                 vq = int(dut.out_qd.value)
                 vn = int(dut.out_q_next.value)
                 vr = int(dut.out_r.value)
