@@ -11,9 +11,14 @@
 //   sweeps x joints: g = <Js_i, cvt<tw_t>(racc)>, gk = cvt_shr<gk_t>(g, k_i),
 //                    qn = clamp(cvt(q'_i + gk c_i)), dq = cvt(qn - q'_i), racc -= Js_i dq
 //   r = cvt<tw_t>(racc), flags (limit / velocity limit active), q_next = clamp(cvt(q + q' dt))
-// One shared registered multiplier (ts_mul) under a sequencer; the six-row products (columns,
-// |Js_i|^2, <Js_i, r>, residual updates) are issued one per cycle, everything else waits for its
-// result.  Every narrowing is a ts_round_sat (the model's cvt: AP_RND + AP_SAT with the flag).
+// One shared registered multiplier (ts_mul) under a sequencer that issues a product whenever it
+// can: each product carries a tag {valid, sink, joint, row} through delay lines as long as the
+// multiplier and a rounder, and the tag says where its result goes.  The per-joint preparation
+// runs as streams over all joints (columns, |Js_j|^2 with the normalisation behind it, e, y, c,
+// the bounds, warm start and racc), the coordinate steps overlap a step's residual update with
+// the next step's dot, and the integration is a stream too; cycles per solve
+// 50 + 9 MLAT + 24 n + sweeps n (3 MLAT + 24), whatever the data (docs/rtl/ts_core_solve.md).
+// Every narrowing is a ts_round_sat (the model's cvt: AP_RND + AP_SAT with the flag).
 //
 // Configuration (raw words of the model's formats in the low bits of in_cfg_data; write while
 // idle): address {global, joint[JI_W-1:0], field[3:0]}
