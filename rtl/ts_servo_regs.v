@@ -369,13 +369,19 @@ module ts_servo_regs #(
   assign wr_ok = wr_glb ? wr_glb_ok : (wr_jnt && wr_jnt_ok);
 
   // ---- read channel -------------------------------------------------------------------
+  // A read takes two cycles: the accepted address (ar_full), then the words selected by it
+  // registered (rd_full: the joint's stored fields and the global word), then the response.
+  // The joint multiplexer reaches every joint's registers across the device; with the field
+  // select and the response in the same cycle it was the whole core's critical path.
   reg         ar_full;
   reg  [9:0]  ar_word;
+  reg  [5:0]  ar_jidx;        // joint index of the accepted address (block - 4)
+  reg         rd_full;
   reg         r_valid;
   reg  [31:0] r_data;
   reg  [1:0]  r_resp;
 
-  assign s_axil_arready = !ar_full && !r_valid;
+  assign s_axil_arready = !ar_full && !rd_full && !r_valid;
   assign s_axil_rvalid = r_valid;
   assign s_axil_rdata = r_data;
   assign s_axil_rresp = r_resp;
@@ -384,7 +390,6 @@ module ts_servo_regs #(
   wire        rd_glb = (ar_word[9:6] == 4'd0);
   wire [5:0]  rd_blk = ar_word[9:4];
   wire        rd_jnt = (rd_blk >= 6'd4) && ({26'd0, rd_blk} < JOINT_END);
-  wire [5:0]  rd_jidx = rd_blk - 6'd4;
 
   // Global write enables
   wire we_ctrl = wr_go && wr_glb && (aw_word[5:0] == 6'h00);
@@ -906,28 +911,34 @@ module ts_servo_regs #(
   endgenerate
 
   // Read word of the addressed joint: the joint's stored fields (one NMAX:1 multiplexer tree,
-  // ts_sel), then the word, then the sign extension.  Selecting the joint first on the stored
-  // bits costs about a fifth of selecting every joint's sign-extended word (ECP5 LUT4).
+  // ts_sel, registered in rj_q), then the word, then the sign extension.  Selecting the joint
+  // first on the stored bits costs about a fifth of selecting every joint's sign-extended word
+  // (ECP5 LUT4).
   wire [JV_W-1:0] rj;
-  ts_sel #(.W(JV_W), .N(NMAX), .IW(6)) u_rd_joint (.in_vec(jnt_vec), .in_idx(rd_jidx), .out_el(rj));
-  wire rj_jcfg_prismatic = rj[JO_JCFG_PRISMATIC +: 1];
-  wire rj_jcfg_limited = rj[JO_JCFG_LIMITED +: 1];
-  wire rj_jcfg_vlimited = rj[JO_JCFG_VLIMITED +: 1];
-  wire [QUAT_W-1:0] rj_origin_qw = rj[JO_ORIGIN_QW +: QUAT_W];
-  wire [QUAT_W-1:0] rj_origin_qx = rj[JO_ORIGIN_QX +: QUAT_W];
-  wire [QUAT_W-1:0] rj_origin_qy = rj[JO_ORIGIN_QY +: QUAT_W];
-  wire [QUAT_W-1:0] rj_origin_qz = rj[JO_ORIGIN_QZ +: QUAT_W];
-  wire [LEN_W-1:0] rj_origin_px = rj[JO_ORIGIN_PX +: LEN_W];
-  wire [LEN_W-1:0] rj_origin_py = rj[JO_ORIGIN_PY +: LEN_W];
-  wire [LEN_W-1:0] rj_origin_pz = rj[JO_ORIGIN_PZ +: LEN_W];
-  wire [QUAT_W-1:0] rj_axis_x = rj[JO_AXIS_X +: QUAT_W];
-  wire [QUAT_W-1:0] rj_axis_y = rj[JO_AXIS_Y +: QUAT_W];
-  wire [QUAT_W-1:0] rj_axis_z = rj[JO_AXIS_Z +: QUAT_W];
-  wire [SCALE_W-1:0] rj_scale = rj[JO_SCALE +: SCALE_W];
-  wire [ANGLE_W-1:0] rj_lower = rj[JO_LOWER +: ANGLE_W];
-  wire [ANGLE_W-1:0] rj_upper = rj[JO_UPPER +: ANGLE_W];
-  wire [QD_W-1:0] rj_vmax = rj[JO_VMAX +: QD_W];
-  wire [MU_W-1:0] rj_mu = rj[JO_MU +: MU_W];
+  reg  [JV_W-1:0] rj_q;
+  ts_sel #(.W(JV_W), .N(NMAX), .IW(6)) u_rd_joint (.in_vec(jnt_vec), .in_idx(ar_jidx), .out_el(rj));
+  always @(posedge clk) begin
+    if (rst) rj_q <= {JV_W{1'b0}};
+    else if (ar_full) rj_q <= rj;
+  end
+  wire rj_jcfg_prismatic = rj_q[JO_JCFG_PRISMATIC +: 1];
+  wire rj_jcfg_limited = rj_q[JO_JCFG_LIMITED +: 1];
+  wire rj_jcfg_vlimited = rj_q[JO_JCFG_VLIMITED +: 1];
+  wire [QUAT_W-1:0] rj_origin_qw = rj_q[JO_ORIGIN_QW +: QUAT_W];
+  wire [QUAT_W-1:0] rj_origin_qx = rj_q[JO_ORIGIN_QX +: QUAT_W];
+  wire [QUAT_W-1:0] rj_origin_qy = rj_q[JO_ORIGIN_QY +: QUAT_W];
+  wire [QUAT_W-1:0] rj_origin_qz = rj_q[JO_ORIGIN_QZ +: QUAT_W];
+  wire [LEN_W-1:0] rj_origin_px = rj_q[JO_ORIGIN_PX +: LEN_W];
+  wire [LEN_W-1:0] rj_origin_py = rj_q[JO_ORIGIN_PY +: LEN_W];
+  wire [LEN_W-1:0] rj_origin_pz = rj_q[JO_ORIGIN_PZ +: LEN_W];
+  wire [QUAT_W-1:0] rj_axis_x = rj_q[JO_AXIS_X +: QUAT_W];
+  wire [QUAT_W-1:0] rj_axis_y = rj_q[JO_AXIS_Y +: QUAT_W];
+  wire [QUAT_W-1:0] rj_axis_z = rj_q[JO_AXIS_Z +: QUAT_W];
+  wire [SCALE_W-1:0] rj_scale = rj_q[JO_SCALE +: SCALE_W];
+  wire [ANGLE_W-1:0] rj_lower = rj_q[JO_LOWER +: ANGLE_W];
+  wire [ANGLE_W-1:0] rj_upper = rj_q[JO_UPPER +: ANGLE_W];
+  wire [QD_W-1:0] rj_vmax = rj_q[JO_VMAX +: QD_W];
+  wire [MU_W-1:0] rj_mu = rj_q[JO_MU +: MU_W];
   // Fixed-point values sign-extended to the 32-bit read word
   generate
     wire [31:0] sx_rj_origin_qw;
@@ -1060,9 +1071,14 @@ module ts_servo_regs #(
       rd_mode, rd_njoints, rd_hwcfg, rd_id, rd_tick_cycles,
       rd_tick_count, rd_flags, rd_cfg_error, rd_status, rd_ctrl};
   wire [31:0] glb_word;
+  reg  [31:0] glb_q;           // the word at ar_word, registered in the read's first cycle
   ts_sel #(.W(32), .N(32), .IW(5)) u_rd_glb (.in_vec(glb_vec), .in_idx(ar_word[4:0]), .out_el(glb_word));
+  always @(posedge clk) begin
+    if (rst) glb_q <= 32'd0;
+    else if (ar_full) glb_q <= glb_word;
+  end
   always @* begin
-    rd_glb_data = glb_word;
+    rd_glb_data = glb_q;
     rd_glb_ok = (ar_word[5:5] == 1'd0) && GLB_MAPPED[ar_word[4:0]];
   end
 
@@ -1070,16 +1086,23 @@ module ts_servo_regs #(
     if (rst) begin
       ar_full <= 1'b0;
       ar_word <= 10'd0;
+      ar_jidx <= 6'd0;
+      rd_full <= 1'b0;
       r_valid <= 1'b0;
       r_data <= 32'd0;
       r_resp <= RESP_OKAY;
     end else begin
-      if (s_axil_arvalid && !ar_full && !r_valid) begin
+      if (s_axil_arvalid && !ar_full && !rd_full && !r_valid) begin
         ar_full <= 1'b1;
         ar_word <= s_axil_araddr[11:2];
+        ar_jidx <= s_axil_araddr[11:6] - 6'd4;
       end
       if (ar_full) begin
         ar_full <= 1'b0;
+        rd_full <= 1'b1;
+      end
+      if (rd_full) begin
+        rd_full <= 1'b0;
         r_valid <= 1'b1;
         r_data <= rd_ok ? rd_data : 32'd0;
         r_resp <= rd_ok ? RESP_OKAY : RESP_SLVERR;
