@@ -234,10 +234,25 @@ module ts_servo_core #(
   reg [31:0] status_w;            // status word of this tick
   reg [WI_W-1:0] ow;              // output word index
 
-  wire [JI_W:0] n_c = c_n[JI_W:0];
-  wire [WI_W-1:0] n_w = {{(WI_W - JI_W - 1){1'b0}}, n_c};
-  wire [WI_W-1:0] last_in = n_w + {{(WI_W - 4){1'b0}}, 4'd13};
-  wire [WI_W-1:0] last_out = n_w + n_w + {{(WI_W - 3){1'b0}}, 3'd7};
+  // The joint count and the packet lengths and offsets it sets, registered: they change only at a
+  // commit, hundreds of cycles before a tick uses them, and the commit engine's shadow count would
+  // otherwise reach the sequencer's comparisons through these adders across the device (the
+  // compact core's critical path post-route, 17.0 ns).
+  reg [JI_W:0] n_c;
+  reg [WI_W-1:0] n_w, n_w2, last_in, last_out, last_out_m1;
+  always @(posedge clk) begin
+    if (rst) begin
+      n_c <= {(JI_W + 1){1'b0}}; n_w <= {WI_W{1'b0}}; n_w2 <= {WI_W{1'b0}};
+      last_in <= {WI_W{1'b0}}; last_out <= {WI_W{1'b0}}; last_out_m1 <= {WI_W{1'b0}};
+    end else begin
+      n_c <= c_n[JI_W:0];
+      n_w <= {{(WI_W - JI_W - 1){1'b0}}, n_c};
+      n_w2 <= n_w + n_w;
+      last_in <= n_w + {{(WI_W - 4){1'b0}}, 4'd13};
+      last_out <= n_w + n_w + {{(WI_W - 3){1'b0}}, 3'd7};
+      last_out_m1 <= n_w + n_w + {{(WI_W - 3){1'b0}}, 3'd6};
+    end
+  end
   wire beat_in = s_axis_tvalid && s_axis_tready;
   wire [JI_W-1:0] qi = wi[JI_W-1:0] - 1'b1;                 // q word -> joint
   wire [WI_W-1:0] si_w = wi - n_w - 1'b1;                   // setpoint word index
@@ -476,7 +491,7 @@ module ts_servo_core #(
   );
 
   // ---- output words --------------------------------------------------------------------------------
-  wire [WI_W-1:0] ow_e = ow - n_w - n_w;           // ep/eo/status/count index
+  wire [WI_W-1:0] ow_e = ow - n_w2;                // ep/eo/status/count index
   wire [JI_W-1:0] oj_d = ow[JI_W-1:0];
   wire [JI_W-1:0] oj_n = ow[JI_W-1:0] - n_c[JI_W-1:0];   // q_next index
   wire [QD_W-1:0] o_qd;
@@ -496,10 +511,10 @@ module ts_servo_core #(
       3'd4: o_eo = eo_y;
       default: o_eo = eo_z;
     endcase
-    if (bad) m_axis_tdata = (ow == last_out - 1'b1) ? 32'h4000_0000 :
+    if (bad) m_axis_tdata = (ow == last_out_m1) ? 32'h4000_0000 :
                             (ow == last_out) ? tick_count : 32'd0;
     else if (ow < n_w) m_axis_tdata = {{(33 - QD_W){o_qd[QD_W-1]}}, o_qd[QD_W-2:0]};
-    else if (ow < n_w + n_w) m_axis_tdata = {{(33 - ANGLE_W){o_qn[ANGLE_W-1]}}, o_qn[ANGLE_W-2:0]};
+    else if (ow < n_w2) m_axis_tdata = {{(33 - ANGLE_W){o_qn[ANGLE_W-1]}}, o_qn[ANGLE_W-2:0]};
     else if (ow_e < 3) m_axis_tdata = {{(33 - PE_W){o_ep[PE_W-1]}}, o_ep[PE_W-2:0]};
     else if (ow_e < 6) m_axis_tdata = {{(33 - RO_W){o_eo[RO_W-1]}}, o_eo[RO_W-2:0]};
     else if (ow_e == 6) m_axis_tdata = status_w;
