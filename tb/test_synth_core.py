@@ -85,16 +85,6 @@ def test_nextpnr_cmd_router():
         assert "density" in str(e)
     else:
         raise AssertionError("density 1.5 accepted")
-    assert cmd[cmd.index("--placer") + 1] == "heap"
-    stat = synth_core.nextpnr_cmd("--45k", Path("a.json"), 1, Path("a.log"), "router2", None, "static")
-    assert stat[stat.index("--placer") + 1] == "static" and "--placer-heap-beta" not in stat
-    for bad, word in (((0.7, "static"), "density"), ((None, "sa"), "sa")):
-        try:
-            synth_core.nextpnr_cmd("--85k", Path("a.json"), 1, Path("a.log"), "router2", *bad)
-        except ValueError as e:
-            assert word in str(e)
-        else:
-            raise AssertionError(f"{bad} accepted")
     try:
         synth_core.nextpnr_cmd("--85k", Path("a.json"), 1, Path("a.log"), "router3")
     except ValueError as e:
@@ -109,8 +99,6 @@ def test_section_names_router_and_device():
     assert synth_core.routers({"default": {"router": "router2"}, "compact": {}}) == "`--router router1` / `--router router2`"
     assert synth_core.routers({"default": {"router": "router2", "density": 0.7}}) == \
         "`--router router2`, default with `--placer-heap-beta 0.7`"
-    assert synth_core.routers({"compact": {"router": "router2", "placer": "static"}}) == \
-        "`--router router2`, compact with `--placer static`"
     assert synth_core.places({"default": {}, "compact": {}}) == "the smallest ECP5 the counts fit"
     both = {"default": {"place_on": "LFE5U-85F"}, "compact": {"place_on": "LFE5U-85F"}}
     assert synth_core.places(both) == "default on LFE5U-85F (`--place-on`); compact on LFE5U-85F (`--place-on`)"
@@ -132,10 +120,3 @@ def test_pnr_logs_router2_progress(tmp_path, monkeypatch):
     r = synth_core.pnr_logs(Path("."))
     assert r["fmax"] == [] and r["fmax_placed"] == 32.77 and r["route_overused"] == (2, 36618)
     assert r["device"] == "LFE5U-85F"
-
-
-def test_density_with_static_placer_refused(capsys):
-    """--density with the static placer is refused at once, with one line, before any synthesis."""
-    assert synth_core.main(["--placer", "static", "--density", "0.7", "--json", "build/none.json"]) == 2
-    err = capsys.readouterr().err.strip().splitlines()
-    assert len(err) == 1 and "--density" in err[0] and "static" in err[0]
