@@ -14,6 +14,7 @@ is reported with the count that does not fit; nothing is placed then.
     .venv/bin/python scripts/synth_core.py --configs compact --seeds 1
     .venv/bin/python scripts/synth_core.py --configs default --engines   # + each engine placed alone
     .venv/bin/python scripts/synth_core.py --place-on LFE5U-85F           # make synth-core
+    .venv/bin/python scripts/synth_core.py --configs compact --place-on LFE5U-45F --lut-resets-below 5
 
 The configurations run side by side. router2 is the default router: it routed the whole compact
 core on LFE5U-85F; on the whole default core (74 % of LFE5U-85F's logic cells) router1 left ~118,000

@@ -168,3 +168,8 @@ def test_lut_resets_below_moves_a_lone_reset_into_the_luts(tmp_path):
     assert (n_ff, n_net) == (1, 1) and len(ffs) == 9
     assert sum(v == rst for v in ffs.values()) == 8
     assert all(v in (rst, None, "0", "1") for v in ffs.values()), ffs
+    # the generated text names the option and what it moved, only for a configuration that used it
+    res = {"compact": {"lut_resets": {"below": 5, "ffs": n_ff, "nets": n_net}}, "default": {"lut_resets": None}}
+    note = synth_core.lut_resets_note(res)
+    assert note.startswith(" compact: ") and "1 flip-flops on 1 reset nets" in note and "`--lut-resets-below 5`" in note
+    assert "default" not in note and synth_core.lut_resets_note({"default": {}}) == ""
