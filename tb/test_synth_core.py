@@ -138,20 +138,12 @@ def _lsr_nets(tmp_path, below):
     {flip-flop name: LSR bit or None}, the bit of port rst, and what mark_small_resets counted."""
     import json
     import shutil
-    import subprocess
     (tmp_path / "t.v").write_text(LSR_RTL)
-    il, js, st = tmp_path / "t.il", tmp_path / "t.json", tmp_path / "stat.txt"
-    first, second = synth_core.yosys_flat_stages(["read_verilog -lib +/ecp5/cells_bb.v", f"read_verilog {tmp_path / 't.v'}"],
-                                                 "t", il, js, st)
+    js, st = tmp_path / "t.json", tmp_path / "stat.txt"
     exe = shutil.which("yosys")
     assert exe, "Debian yosys is not installed (scripts/setup_system.sh installs it)"
-    for i, script in enumerate((first, None, second)):
-        if script is None:
-            text, n_ff, n_net = synth_core.mark_small_resets(il.read_text(), "t", below)
-            il.write_text(text)
-            continue
-        (tmp_path / f"s{i}.ys").write_text(script)
-        subprocess.run([exe, "-q", "-s", str(tmp_path / f"s{i}.ys")], check=True, capture_output=True, timeout=300)
+    n_ff, n_net = synth_core.yosys_flat_lut_resets(
+        exe, ["read_verilog -lib +/ecp5/cells_bb.v", f"read_verilog {tmp_path / 't.v'}"], "t", tmp_path, js, st, below)
     m = json.loads(js.read_text())["modules"]["t"]
     ffs = {n: (c["connections"].get("LSR") or [None])[0] for n, c in m["cells"].items() if c["type"] == "TRELLIS_FF"}
     return ffs, m["ports"]["rst"]["bits"][0], (n_ff, n_net)
