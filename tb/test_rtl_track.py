@@ -13,7 +13,7 @@ second half of the run (docs/numerics.md, tracking).
 Ticks per run: TS_RTL_TICKS (default 100 at 10 sweeps); ``make soak`` runs 10,000 ticks per chain
 and configuration at 2 sweeps (TS_RTL_TICKS=10000 TS_RTL_SWEEPS=2); TS_SEED replays the random
 chain.  The 20-joint chain runs through the core built with NMAX = 20 in ``make soak`` (or with
-TS_RTL_WIDE=1).  The CLI test checks ``tservo track --model rtl`` output files against ``--model fixed``
+TS_RTL_WIDE=1); UR5 through the core built with NMAX = 6 (``--nmax``) in every run.  The CLI test checks ``tservo track --model rtl`` output files against ``--model fixed``
 and its one-line errors.
 """
 from __future__ import annotations
@@ -116,6 +116,20 @@ def test_rtl_core_above_nmax_8_tracks_bit_identical():
     print(f"[rtl track] chain20 compact NMAX=20: {nt} ticks identical; {min(tick.core.cycles)} cycles per tick")
 
 
+def test_rtl_core_built_for_six_joints_tracks_bit_identical():
+    """UR5 through the core built with NMAX = 6, the smallest core for a 6-joint arm (the tests
+    above build NMAX 8): compact, 2 sweeps, 40 ticks, every output identical to the model."""
+    ch = robots.load("ur5")
+    q0 = start(ch, "ur5", np.random.default_rng(SEED + 3))
+    T, V = path_for(ch, q0, 40)
+    res, _, _ = run_model("fixed", ch, T, V, q0, Plant(q0, DT), config="compact", dt=DT, sweeps=2)
+    rt, tick, _ = run_model("rtl", ch, T, V, q0, Plant(q0, DT), config="compact", dt=DT, sweeps=2, nmax=6)
+    assert tick.core.nmax == 6
+    for k in ("q", "qd", "flags", "pos_err", "rot_err"):
+        assert np.array_equal(getattr(res, k), getattr(rt, k)), (k, SEED)
+    print(f"[rtl track] ur5 compact NMAX=6: 40 ticks identical; {min(tick.core.cycles)} cycles per tick")
+
+
 @pytest.mark.parametrize("cfg", ["default", "compact"])
 @pytest.mark.parametrize("name", ["puma560", "panda"])
 def test_rtl_core_within_tolerance_of_float(name, cfg):
@@ -157,9 +171,11 @@ def test_tservo_track_model_rtl_cli(tmp_path):
     for k in outs["fixed"]:
         assert np.array_equal(outs["fixed"][k], outs["rtl"][k]), k
     # what the core cannot do is refused before anything runs
-    for extra, field in ((["--setpoint-frame", "2"], "--setpoint-frame"), (["--sweeps", "300"], "--sweeps"),
-                         (["--warm", "18"], "--warm")):
-        r = _tservo("track", "puma560", "--path", "p.npz", "--q0", "q0.npy", "--model", "rtl", *extra, "-o", "bad.npz",
+    for model, extra, field in (("rtl", ["--setpoint-frame", "2"], "--setpoint-frame"),
+                                ("rtl", ["--sweeps", "300"], "--sweeps"), ("rtl", ["--warm", "18"], "--warm"),
+                                ("rtl", ["--nmax", "5"], "--nmax"), ("rtl", ["--nmax", "61"], "--nmax"),
+                                ("fixed", ["--nmax", "8"], "--nmax")):
+        r = _tservo("track", "puma560", "--path", "p.npz", "--q0", "q0.npy", "--model", model, *extra, "-o", "bad.npz",
                     cwd=tmp_path)
         assert r.returncode == 2, (extra, r.returncode, r.stderr)
         lines = r.stderr.strip().splitlines()

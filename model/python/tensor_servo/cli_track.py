@@ -56,6 +56,8 @@ def register(sub) -> None:
     p.add_argument("--path", required=True, help="setpoints: .npz with T (K,4,4), V (K,6), dt")
     p.add_argument("--q0", required=True, help="initial joint values, .npy (n,)")
     _add_model(p, rtl=True)
+    p.add_argument("--nmax", type=int, default=None,
+                   help="--model rtl: the core's NMAX parameter, the joints it is built for (n..60; default max(8, n))")
     p.add_argument("--mode", choices=("A", "B"), default="A", help="error choice A (root basis) or B (body basis)")
     p.add_argument("--error-only", action="store_true", help="no feed-forward of the setpoint twist")
     p.add_argument("--kp", type=float, help="position gain (1/s)")
@@ -219,6 +221,10 @@ def cmd_track(args) -> int:
     T = check_poses(T, "--path: T")
     dt = check_dt(dt_arr, "--path: dt")
     params = servo_params(args, ch, dt)
+    if args.nmax is not None:
+        if args.model != "rtl":
+            raise InputError("--nmax", f"only --model rtl builds a core with an NMAX (got --model {args.model})")
+        params["nmax"] = args.nmax
     warm = _warm(args.warm) or TRACK_DEFAULTS["warm"]
     lag = _positive(args.lag, "--lag", allow_zero=True)
     counts = None if args.counts is None else _positive(args.counts, "--counts")

@@ -41,6 +41,7 @@ HARNESS = ROOT / "tb" / "harness" / "ts_servo_core_harness.cpp"
 BUILD = ROOT / "build" / "vcore"
 CONFIG_INDEX = {"default": 0, "compact": 1}
 NMAX_DEFAULT = 8
+NMAX_LIMIT = 60                 # joint blocks of the register map (0x100 + 0x40 j < 4 KiB)
 LEAK_MAX = regs.MODE_WARM_LEAK_MASK >> regs.MODE_WARM_LEAK_SHIFT     # 4-bit field
 SWEEPS_MAX = regs.MODE_SWEEPS_MASK >> regs.MODE_SWEEPS_SHIFT         # 8-bit field
 IN_COLD = 1                     # input packet control word: bit 0 COLD (bit 1 LOAD_Q: virtual mode, unused here)
@@ -177,7 +178,12 @@ class RtlServo:
     """The servo tick of one chain run by the Verilated core (same contract as servo.Servo.tick,
     one task, setpoints in the root frame)."""
 
-    def __init__(self, chain: Chain, config: str = "default", dt: float = 1e-3, **params):
+    def __init__(self, chain: Chain, config: str = "default", dt: float = 1e-3, nmax: int | None = None, **params):
+        """nmax: the core's NMAX parameter, the joints it is built for (n..NMAX_LIMIT; None: core_nmax(n),
+        the core's default 8 or n); each (config, NMAX) is Verilated once under build/vcore/."""
+        if nmax is not None and not chain.n <= int(nmax) <= NMAX_LIMIT:
+            raise InputError("--nmax", f"the core is built for NMAX joints, {chain.n} (this chain) to {NMAX_LIMIT} "
+                                       f"(got {nmax})")
         if config not in CONFIG_INDEX:
             raise InputError("--config", f"the rtl model runs default or compact (got {config!r})")
         if params.get("setpoint_frame", -1) not in (-1, None):
@@ -195,7 +201,7 @@ class RtlServo:
         except ValueError as e:
             raise InputError("--model rtl", str(e)) from None
         self.chain, self.config, self.n = chain, config, chain.n
-        self.nmax = core_nmax(chain.n)
+        self.nmax = core_nmax(chain.n) if nmax is None else int(nmax)
         f = formats(config)
         self.lsb = {k: 2.0 ** (f[k][1] - f[k][0]) for k in ("qd_t", "angle_t", "perr_t", "rot_t")}
         self.sim = CoreSim(config, self.nmax)
