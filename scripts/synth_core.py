@@ -133,17 +133,19 @@ def yosys_flat_lut_resets(exe: str, read_lines: list[str], top: str, d: Path, ou
     logs and the RTLIL go to d (relative to cwd, where yosys runs).  Returns (flip-flops marked,
     reset nets they use)."""
     il = d / "ecp5_pre_ffs.il"
-    stages = dict(zip(("ecp5_flat", "ecp5_flat2"), yosys_flat_stages(read_lines, top, il, out_json, stat)))
-    n_ff = n_net = 0
-    for name, script in stages.items():
-        if name == "ecp5_flat2":
-            text, n_ff, n_net = mark_small_resets((cwd / il).read_text(), top, below)
-            (cwd / il).write_text(text)
+    first, second = yosys_flat_stages(read_lines, top, il, out_json, stat)
+
+    def yosys(name: str, script: str) -> None:
         (cwd / d / f"{name}.ys").write_text(script)
         done = subprocess.run([exe, "-q", "-l", str(cwd / d / f"{name}_yosys.log"), "-s", str(cwd / d / f"{name}.ys")],
                               cwd=cwd, stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT, timeout=4 * 3600)
         if done.returncode != 0:
             raise RuntimeError(f"{top}: synth_ecp5 failed, see {d}/{name}_yosys.log")
+
+    yosys("ecp5_flat", first)
+    text, n_ff, n_net = mark_small_resets((cwd / il).read_text(), top, below)
+    (cwd / il).write_text(text)
+    yosys("ecp5_flat2", second)
     return n_ff, n_net
 
 

@@ -13,8 +13,9 @@ second half of the run (docs/numerics.md, tracking).
 Ticks per run: TS_RTL_TICKS (default 100 at 10 sweeps); ``make soak`` runs 10,000 ticks per chain
 and configuration at 2 sweeps (TS_RTL_TICKS=10000 TS_RTL_SWEEPS=2); TS_SEED replays the random
 chain.  The 20-joint chain runs through the core built with NMAX = 20 in ``make soak`` (or with
-TS_RTL_WIDE=1); UR5 through the core built with NMAX = 6 (``--nmax``) in every run.  The CLI test checks ``tservo track --model rtl`` output files against ``--model fixed``
-and its one-line errors.
+TS_RTL_WIDE=1); UR5 through the core built with NMAX = 6 (``--nmax``) in every run.  The CLI
+test checks ``tservo track --model rtl`` output files against ``--model fixed`` and its one-line
+errors.
 """
 from __future__ import annotations
 
@@ -100,33 +101,35 @@ def test_rtl_core_tracks_bit_identical_to_the_model(name, cfg):
 WIDE = os.environ.get("TS_RTL_WIDE", "0") == "1" or NT >= 1000
 
 
+def _compact_core_matches_model(name: str, nt: int, seed: int, **rtl) -> object:
+    """``name`` tracking its circle for nt ticks in the compact configuration at 2 sweeps, with the
+    model and through the core (rtl: RtlServo options, e.g. nmax): every output identical.
+    Returns the rtl tick model (``.core``: nmax, cycles)."""
+    ch = robots.load(name)
+    q0 = start(ch, name, np.random.default_rng(seed))
+    T, V = path_for(ch, q0, nt)
+    res, _, _ = run_model("fixed", ch, T, V, q0, Plant(q0, DT), config="compact", dt=DT, sweeps=2)
+    rt, tick, _ = run_model("rtl", ch, T, V, q0, Plant(q0, DT), config="compact", dt=DT, sweeps=2, **rtl)
+    for k in ("q", "qd", "flags", "pos_err", "rot_err"):
+        assert np.array_equal(getattr(res, k), getattr(rt, k)), (name, k, SEED)
+    return tick
+
+
 @pytest.mark.skipif(not WIDE, reason="make soak runs it (TS_RTL_WIDE=1): the NMAX = 20 core build is slow")
 def test_rtl_core_above_nmax_8_tracks_bit_identical():
     """The 20-joint chain through the whole core built with NMAX = 20 (compact, 2 sweeps,
     max(30, TS_RTL_TICKS / 5) ticks): every output identical to the model."""
-    ch = robots.load("chain20")
     nt = max(30, NT // 5)
-    q0 = start(ch, "chain20", np.random.default_rng(SEED + 2))
-    T, V = path_for(ch, q0, nt)
-    res, tick, _ = run_model("fixed", ch, T, V, q0, Plant(q0, DT), config="compact", dt=DT, sweeps=2)
-    rt, tick, _ = run_model("rtl", ch, T, V, q0, Plant(q0, DT), config="compact", dt=DT, sweeps=2)
+    tick = _compact_core_matches_model("chain20", nt, SEED + 2)
     assert tick.core.nmax == 20
-    for k in ("q", "qd", "flags", "pos_err", "rot_err"):
-        assert np.array_equal(getattr(res, k), getattr(rt, k)), (k, SEED)
     print(f"[rtl track] chain20 compact NMAX=20: {nt} ticks identical; {min(tick.core.cycles)} cycles per tick")
 
 
 def test_rtl_core_built_for_six_joints_tracks_bit_identical():
     """UR5 through the core built with NMAX = 6, the smallest core for a 6-joint arm (the tests
     above build NMAX 8): compact, 2 sweeps, 40 ticks, every output identical to the model."""
-    ch = robots.load("ur5")
-    q0 = start(ch, "ur5", np.random.default_rng(SEED + 3))
-    T, V = path_for(ch, q0, 40)
-    res, _, _ = run_model("fixed", ch, T, V, q0, Plant(q0, DT), config="compact", dt=DT, sweeps=2)
-    rt, tick, _ = run_model("rtl", ch, T, V, q0, Plant(q0, DT), config="compact", dt=DT, sweeps=2, nmax=6)
+    tick = _compact_core_matches_model("ur5", 40, SEED + 3, nmax=6)
     assert tick.core.nmax == 6
-    for k in ("q", "qd", "flags", "pos_err", "rot_err"):
-        assert np.array_equal(getattr(res, k), getattr(rt, k)), (k, SEED)
     print(f"[rtl track] ur5 compact NMAX=6: 40 ticks identical; {min(tick.core.cycles)} cycles per tick")
 
 

@@ -391,13 +391,16 @@ if os.environ.get("COCOTB_SIM") or os.environ.get("TOPLEVEL"):
         await closed_loop(tb, lp, 3, load_at=())
         assert not tb.errors, f"{len(tb.errors)} mismatches, first: {tb.errors[0]}"
 
+    #: the FLAGS register's bits (the model's status bits 0-9, 16, 17)
+    FLAG_BITS = sum(f.mask for f in regs.GLOBAL["FLAGS"].fields)
 
     @cocotb.test()
     async def flags_and_virtual_switch(dut):
-        """FLAGS against the packets' status words: after ticks, FLAGS is the OR of their flag bits
-        (status bits 0-17); a far setpoint (0.2 m off the path) makes the model's limit flags rise,
-        a fast one (31 m/s) its servo saturation flag; writing 1 clears flags, CTRL.CLEAR all.  CTRL.VIRTUAL switched between ticks (no commit): with
-        the packet's q moved off the core's own q, each tick must take the q of its mode."""
+        """FLAGS against the packets' status words: after ticks, FLAGS is the OR of their flag
+        bits; a far setpoint (0.2 m off the path) makes the model's limit flags rise, a fast one
+        (31 m/s) its servo saturation flag; writing 1 clears flags, CTRL.CLEAR all.  CTRL.VIRTUAL
+        switched between ticks (no commit): with the packet's q moved off the core's own q, each
+        tick must take the q of its mode."""
         tb = await setup(dut)
         tb.gaps(False)
         lp = await bring_up(tb, "puma560", sweeps=2)
@@ -418,8 +421,9 @@ if os.environ.get("COCOTB_SIM") or os.environ.get("TOPLEVEL"):
             exp = lp.expect(sp)
             got = await tb.tick_io(words)
             compare(tb, f"flags tick {lp.k - 1}{' (far)' if far else ''}{' (fast)' if fast else ''}", exp, got)
-            seen |= exp[2 * n + 6] & 0x3FFFF
-            return exp[2 * n + 6] & 0x3FFFF
+            flags = exp[2 * n + 6] & FLAG_BITS
+            seen |= flags
+            return flags
 
         for _ in range(2):
             await tick()
