@@ -54,8 +54,7 @@ def test_up_to_date_tolerates_the_last_bits_only():
     """The files are compared with a few units in the last place (BLAS kernels differ per CPU), but
     a real change of a number, a key, a string or an integer still makes a file stale."""
     text = robots.path("chain20").read_text()
-    doc = json.loads(text)
-    axis = doc["joints"][3]["axis"]
+    axis = json.loads(text)["joints"][3]["axis"]
 
     def with_axis0(v):
         d = json.loads(text)

@@ -90,9 +90,8 @@ ULPS = 4
 
 
 def _same(a, b) -> bool:
-    if isinstance(a, float) or isinstance(b, float):
-        return (isinstance(a, (int, float)) and isinstance(b, (int, float)) and not isinstance(a, bool)
-                and not isinstance(b, bool) and abs(a - b) <= ULPS * math.ulp(max(abs(a), abs(b))))
+    if float in (type(a), type(b)):     # a JSON number on either side (type(), so a bool is no number)
+        return {type(a), type(b)} <= {int, float} and abs(a - b) <= ULPS * math.ulp(max(abs(a), abs(b)))
     if isinstance(a, dict) and isinstance(b, dict):
         return list(a) == list(b) and all(_same(a[k], b[k]) for k in a)
     if isinstance(a, list) and isinstance(b, list):
