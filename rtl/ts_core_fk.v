@@ -49,6 +49,9 @@ module ts_core_fk #(
   // Products per multiplier of the quaternion product, the offset rotation and the screw
   // transport (ts_mul_bank); the columns are issued one per FOLD cycles
   parameter FOLD = 1,
+  // Folded multiplier banks (FOLD > 1): 1 holds their operands and products in shift chains
+  // (ts_mul_bank CHAIN; the same bits and cycles, more registers, shorter wires).
+  parameter CHAIN = 0,
   // Joint index width: derived from NMAX, do not override
   parameter JI_W = (NMAX > 1) ? $clog2(NMAX) : 1,
   // Width of angle_t: derived from CONFIG, do not override
@@ -320,7 +323,7 @@ module ts_core_fk #(
   reg signed [Q_W-1:0] qm_b [0:3];
   wire qm_ovalid, qm_sat;
   wire signed [Q_W-1:0] qm_o [0:3];
-  ts_quat_mul #(.Q_W(Q_W), .Q_F(Q_F), .TARGET(TARGET), .FOLD(FOLD)) u_qm (
+  ts_quat_mul #(.Q_W(Q_W), .Q_F(Q_F), .TARGET(TARGET), .FOLD(FOLD), .CHAIN(CHAIN)) u_qm (
     .clk(clk), .rst(rst), .in_valid(qm_valid),
     .in_a_w(qm_a[0]), .in_a_x(qm_a[1]), .in_a_y(qm_a[2]), .in_a_z(qm_a[3]),
     .in_b_w(qm_b[0]), .in_b_x(qm_b[1]), .in_b_y(qm_b[2]), .in_b_z(qm_b[3]),
@@ -334,7 +337,7 @@ module ts_core_fk #(
   wire signed [P_W-1:0] ro_o [0:2];
   ts_quat_rotate #(
     .Q_W(Q_W), .Q_F(Q_F), .V_W(LN_W), .V_F(LN_F), .T_W(TS_LEN_TMP_W), .T_F(TS_LEN_TMP_F),
-    .O_W(P_W), .O_F(P_F), .INV(0), .TARGET(TARGET), .FOLD(FOLD)
+    .O_W(P_W), .O_F(P_F), .INV(0), .TARGET(TARGET), .FOLD(FOLD), .CHAIN(CHAIN)
   ) u_ro (
     .clk(clk), .rst(rst), .in_valid(ro_valid),
     .in_q_w(qm_a[0]), .in_q_x(qm_a[1]), .in_q_y(qm_a[2]), .in_q_z(qm_a[3]),
@@ -388,7 +391,7 @@ module ts_core_fk #(
   ts_screw_transport #(
     .Q_W(Q_W), .Q_F(Q_F), .UT_W(TS_UVEC_TMP_W), .UT_F(TS_UVEC_TMP_F), .S_W(S_W), .S_F(S_F),
     .P_W(P_W), .P_F(P_F), .L_W(L_W), .L_F(L_F), .JW_W(JW_W), .JW_F(TS_JW_F), .JV_W(JV_W),
-    .JV_F(TS_JV_F), .TARGET(TARGET), .FOLD(FOLD)
+    .JV_F(TS_JV_F), .TARGET(TARGET), .FOLD(FOLD), .CHAIN(CHAIN)
   ) u_st (
     .clk(clk), .rst(rst), .in_valid(st_valid),
     .in_q_w(st_q[0]), .in_q_x(st_q[1]), .in_q_y(st_q[2]), .in_q_z(st_q[3]),
@@ -410,7 +413,7 @@ module ts_core_fk #(
   wire signed [P_W-1:0] pp_o [0:2];
   ts_delay #(.W(1), .DEPTH(MLP+1+RL)) u_ppv (.clk(clk), .rst(rst), .din(pp_valid), .dout(pp_ovalid));
   wire [3*(L_W+Q_W)-1:0] pp_p;
-  ts_mul_bank #(.N(3), .FOLD(FOLD), .A_W(L_W), .B_W(Q_W), .TARGET(TARGET)) u_mpp (
+  ts_mul_bank #(.N(3), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(L_W), .B_W(Q_W), .TARGET(TARGET)) u_mpp (
     .clk(clk), .rst(rst), .in_valid(pp_valid), .in_a({rd_j, rd_j, rd_j}), .in_b({zr[2], zr[1], zr[0]}),
     .out_p(pp_p));
   generate

@@ -22,7 +22,10 @@ module ts_quat_mul #(
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
   parameter TARGET = "GENERIC",
   // Products per multiplier (cycles per product, II); 1: 16 multipliers in parallel
-  parameter FOLD = 1
+  parameter FOLD = 1,
+  // Folded multiplier banks (FOLD > 1): 1 holds their operands and products in shift chains
+  // (ts_mul_bank CHAIN; the same bits and cycles, more registers, shorter wires).
+  parameter CHAIN = 0
 ) (
   input  wire                  clk,
   input  wire                  rst,
@@ -69,7 +72,7 @@ module ts_quat_mul #(
       end
     end
   endgenerate
-  ts_mul_bank #(.N(16), .FOLD(FOLD), .A_W(Q_W), .B_W(Q_W), .TARGET(TARGET)) u_bank (
+  ts_mul_bank #(.N(16), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(Q_W), .B_W(Q_W), .TARGET(TARGET)) u_bank (
     .clk(clk), .rst(rst), .in_valid(in_valid), .in_a(ba), .in_b(bb), .out_p(bp));
 
   // Level 1: eight pairwise sums, P_W + 1 bits (exact).

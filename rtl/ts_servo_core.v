@@ -29,7 +29,10 @@ module ts_servo_core #(
   // Default: the smallest fold at which the core's MULT18X18D fit the budget of its device
   // (default configuration: 9, about 143 of LFE5U-85F's 156; compact: 7, about 44 of LFE5U-45F's
   // 72; up to 7 it costs no column throughput, as the solver takes a column per 7 cycles).
-  parameter FOLD = (CONFIG == 0) ? 9 : 7
+  parameter FOLD = (CONFIG == 0) ? 9 : 7,
+  // 1: the FK and law engines' folded banks hold operands and products in shift chains (the same
+  // bits and cycles; more registers and LUTs, shorter wires: docs/resources.md has both on ECP5).
+  parameter CHAIN = 0
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -394,7 +397,7 @@ module ts_servo_core #(
   wire signed [JV_W-1:0] fc_vx, fc_vy, fc_vz;
   wire signed [P_W-1:0] fc_px, fc_py, fc_pz;
 
-  ts_core_fk #(.NMAX(NMAX), .CONFIG(CONFIG), .ROM_FILE(TRIG_ROM), .TARGET(TARGET), .FOLD(FOLD)) u_fk (
+  ts_core_fk #(.NMAX(NMAX), .CONFIG(CONFIG), .ROM_FILE(TRIG_ROM), .TARGET(TARGET), .FOLD(FOLD), .CHAIN(CHAIN)) u_fk (
     .clk(clk), .rst(rst),
     .in_cfg_we(fk_we_q), .in_cfg_addr(ld_q), .in_cfg_data(fk_cd_q),
     .in_q_we(in_prep && !psub), .in_q_addr(pjj), .in_q_data(q_sel),
@@ -419,7 +422,7 @@ module ts_servo_core #(
   wire signed [JW_W-1:0] lc_wx, lc_wy, lc_wz;
   wire signed [JV_W-1:0] lc_vx, lc_vy, lc_vz;
 
-  ts_core_law #(.CONFIG(CONFIG), .ROM_FILE(ROTVEC_ROM), .TARGET(TARGET), .FOLD(FOLD)) u_law (
+  ts_core_law #(.CONFIG(CONFIG), .ROM_FILE(ROTVEC_ROM), .TARGET(TARGET), .FOLD(FOLD), .CHAIN(CHAIN)) u_law (
     .clk(clk), .rst(rst), .in_start(law_start), .in_mode_b(c_err_b), .in_err_only(c_err_only),
     .in_kp(c_kp), .in_ko(c_ko), .out_busy(law_busy), .out_done(law_done), .out_flags(law_flags),
     .in_tool_q_w(tq_w), .in_tool_q_x(tq_x), .in_tool_q_y(tq_y), .in_tool_q_z(tq_z),

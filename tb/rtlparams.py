@@ -334,14 +334,16 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
     for w in (4, 32, 40):
         jobs.append(("ts_clamp", sources("ts_clamp"), {"W": w}))
     # the multiplier bank: parallel, folded with and without padding slots, one multiplier
-    for n, fold in ((6, 1), (16, 4), (9, 7), (6, 6), (3, 7)):
+    for n, fold in ((6, 1), (16, 4), (9, 7), (6, 6), (3, 7), (5, 2)):
         for target in TARGETS:
-            jobs.append(("ts_mul_bank", sources("ts_mul_bank", target),
-                         {"N": n, "FOLD": fold, "A_W": 18, "B_W": 27, "TARGET": target}))
-    # the folded primitives (the servo core's FOLD)
+            for chain in ((0, 1) if fold > 1 else (0,)):
+                jobs.append(("ts_mul_bank", sources("ts_mul_bank", target),
+                             {"N": n, "FOLD": fold, "A_W": 18, "B_W": 27, "TARGET": target, "CHAIN": chain}))
+    # the folded primitives (the servo core's FOLD), both forms of the held operands
     for cfg in CONFIGS:
         for m in ("ts_quat_mul", "ts_quat_rotate", "ts_screw_transport"):
-            jobs.append((m, sources(m), dict(module_params(m, cfg), FOLD=7)))
+            for chain in (0, 1):
+                jobs.append((m, sources(m), dict(module_params(m, cfg), FOLD=7, CHAIN=chain)))
     # the generated register block (rtl/ts_servo_regs.rdl): joint counts at the extremes, both configurations
     for nmax in (1, 8, 60):
         for config in (0, 1):
@@ -383,9 +385,10 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
         for target in TARGETS:
             for nmax in (8, 20):
                 jobs.append(("ts_servo_core", sources("ts_servo_core", target), servo_core(CONFIGS[config], target, nmax)))
-        # fully parallel (FOLD 1) and a fold above the column interval
+        # fully parallel (FOLD 1), a fold above the column interval, the shift-chain banks
         for fold in (1, 9):
             jobs.append(("ts_servo_core", sources("ts_servo_core"), dict(servo_core(CONFIGS[config], "GENERIC", 8), FOLD=fold)))
+        jobs.append(("ts_servo_core", sources("ts_servo_core", "ECP5"), dict(servo_core(CONFIGS[config], "ECP5", 8), CHAIN=1)))
     return jobs
 
 

@@ -167,7 +167,8 @@ def run_unit(module: str, test_file: str, p: dict, cfg: str, sim: str, fold: int
     if nvec:
         env["TS_NVEC"] = str(nvec)
     run_bench(toplevel=module, test_file=test_file, sources=sources(module, target), parameters=p, sim=sim,
-              build_name=f"{cfg}-{target}-" + (f"fold{fold}" if fold > 1 else sim), env=env)
+              build_name=f"{cfg}-{target}-" + (f"fold{fold}" if fold > 1 else sim)
+              + (f"-chain{p['CHAIN']}" if p.get("CHAIN") else ""), env=env)
 
 
 def to_signed(u: int, w: int) -> int:

@@ -69,9 +69,11 @@ def test_ts_quat_mul(cfg, sim):
     tsbench.run_unit(MODULE, __file__, rtlparams.quat_mul(cfg, tsbench.target_for(sim)), cfg, sim)
 
 
-@pytest.mark.parametrize("fold", (5,))
+@pytest.mark.parametrize("chain", (0, 1))
+@pytest.mark.parametrize("fold", (2, 5))
 @pytest.mark.parametrize("cfg", ["compact"])    # make test time; the default configuration is folded in the core (harness runs)
-def test_ts_quat_mul_folded(cfg, fold):
-    """The folded form (16 / FOLD multipliers, II = FOLD): the same bits, the documented latency."""
-    tsbench.run_unit(MODULE, __file__, rtlparams.quat_mul(cfg, tsbench.target_for("verilator")), cfg, "verilator",
-                     fold=fold, nvec=2000)
+def test_ts_quat_mul_folded(cfg, fold, chain):
+    """The folded form (16 / FOLD multipliers, II = FOLD), with a select or shift chains for the
+    held operands: the same bits, the documented latency."""
+    tsbench.run_unit(MODULE, __file__, dict(rtlparams.quat_mul(cfg, tsbench.target_for("verilator")), CHAIN=chain),
+                     cfg, "verilator", fold=fold, nvec=2000)

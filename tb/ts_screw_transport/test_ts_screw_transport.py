@@ -106,9 +106,11 @@ def test_ts_screw_transport(cfg, sim):
     tsbench.run_unit(MODULE, __file__, rtlparams.screw_transport(cfg, tsbench.target_for(sim)), cfg, sim)
 
 
+@pytest.mark.parametrize("chain", (0, 1))
 @pytest.mark.parametrize("fold", (3,))
 @pytest.mark.parametrize("cfg", ["compact"])    # make test time; the default configuration is folded in the core (harness runs)
-def test_ts_screw_transport_folded(cfg, fold):
-    """The folded form (FOLD products per multiplier, II = FOLD): the same bits, the documented latency."""
-    tsbench.run_unit(MODULE, __file__, rtlparams.screw_transport(cfg, tsbench.target_for("verilator")), cfg,
-                     "verilator", fold=fold, nvec=2000)
+def test_ts_screw_transport_folded(cfg, fold, chain):
+    """The folded form (FOLD products per multiplier, II = FOLD), with a select or shift chains for
+    the held operands: the same bits, the documented latency."""
+    tsbench.run_unit(MODULE, __file__, dict(rtlparams.screw_transport(cfg, tsbench.target_for("verilator")), CHAIN=chain),
+                     cfg, "verilator", fold=fold, nvec=2000)

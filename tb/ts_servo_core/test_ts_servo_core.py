@@ -473,23 +473,25 @@ def sources(target: str, sim: str) -> list[str]:
 # in closed loop through the Verilator harness (tb/test_rtl_track.py, 5 chains, every output word
 # compared with the model; make soak: 10,000 ticks each).  TS_CORE_DEFAULT=1 adds the default
 # configuration on Verilator here (about 3 more minutes), as it ran until the harness tests came.
-CORE_RUNS = [("compact", "verilator"), ("compact", "icarus")]
+# The third run builds the compact core with its folded banks' operands in shift chains (CHAIN 1,
+# the same bits and cycles) and runs fewer ticks.
+CORE_RUNS = [("compact", "verilator", 0), ("compact", "icarus", 0), ("compact", "verilator", 1)]
 if os.environ.get("TS_CORE_DEFAULT") == "1":
-    CORE_RUNS.insert(0, ("default", "verilator"))
+    CORE_RUNS.insert(0, ("default", "verilator", 0))
 
 
-@pytest.mark.parametrize("cfg,sim", CORE_RUNS)
-def test_ts_servo_core(cfg, sim):
+@pytest.mark.parametrize("cfg,sim,chain", CORE_RUNS)
+def test_ts_servo_core(cfg, sim, chain):
     target = tsbench.target_for(sim) if cfg == "compact" else "GENERIC"
     p = {"NMAX": NMAX, "CONFIG": tsbench.CONFIGS.index(cfg), "TARGET": target,
          "TRIG_ROM": str(rtlparams.RTL / f"ts_trig_rom_{cfg}.mem"),
          "RECIP_ROM": str(rtlparams.RTL / f"ts_recip_rom_{cfg}.mem"),
-         "ROTVEC_ROM": str(rtlparams.RTL / f"ts_rotvec_rom_{cfg}.mem")}
-    build = f"{cfg}-{target}-{sim}"
+         "ROTVEC_ROM": str(rtlparams.RTL / f"ts_rotvec_rom_{cfg}.mem"), "CHAIN": chain}
+    build = f"{cfg}-{target}-{sim}" + ("-chain1" if chain else "")
     cyc_file = tsbench.BUILD / MODULE / f"cycles-{build}.json"
     cyc_file.parent.mkdir(parents=True, exist_ok=True)
     # ticks per robot: the simulators run about 10-40 kcycles/s (Verilator) and 2 kcycles/s (Icarus)
-    nt = os.environ.get("TS_NT", "6" if sim == "verilator" else "1")
+    nt = os.environ.get("TS_NT", "1" if sim == "icarus" else "2" if chain else "6")
     tsbench.run_bench(toplevel=MODULE, test_file=__file__, sources=sources(target, sim), parameters=p,
                       sim=sim, build_name=build,
                       env={"TS_CONFIG": cfg, "TS_NT": nt, "TS_CYCLES_FILE": str(cyc_file),
