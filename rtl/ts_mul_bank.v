@@ -75,28 +75,30 @@ module ts_mul_bank #(
         assign pa = in_a;
         assign pb = in_b;
       end
+      // phase of this cycle's operands when not 0 (both forms)
+      reg  [PH_W-1:0] ph;
+      always @(posedge clk) begin
+        if (rst) ph <= {PH_W{1'b0}};
+        else if (in_valid) ph <= {{(PH_W-1){1'b0}}, 1'b1};
+        else if (ph != {PH_W{1'b0}}) ph <= (ph == LAST) ? {PH_W{1'b0}} : ph + 1'b1;
+      end
+      wire act = in_valid | (ph != {PH_W{1'b0}});
       if (CHAIN == 0) begin : g_select
         // one copy of the held operands, a FOLD:1 ts_sel per multiplier input; the products of the
         // phases before the last captured in a register per slot
         // held operands of phases 1 .. FOLD-1 (slot s at [(s-L)*W])
         reg  [(NP-L)*A_W-1:0] ha;
         reg  [(NP-L)*B_W-1:0] hb;
-        reg  [PH_W-1:0]   ph;                       // phase of this cycle's operands when not 0
         always @(posedge clk) begin
           if (rst) begin
             ha <= {((NP-L)*A_W){1'b0}};
             hb <= {((NP-L)*B_W){1'b0}};
-            ph <= {PH_W{1'b0}};
           end else if (in_valid) begin
             ha <= pa[NP*A_W-1:L*A_W];
             hb <= pb[NP*B_W-1:L*B_W];
-            ph <= {{(PH_W-1){1'b0}}, 1'b1};
-          end else if (ph != {PH_W{1'b0}}) begin
-            ph <= (ph == LAST) ? {PH_W{1'b0}} : ph + 1'b1;
           end
         end
         wire [PH_W-1:0] sel = in_valid ? {PH_W{1'b0}} : ph;
-        wire            act = in_valid | (ph != {PH_W{1'b0}});
 
         // phase of the products at the multiplier outputs
         wire [PH_W:0] osel;
@@ -154,16 +156,6 @@ module ts_mul_bank #(
         // (docs/rtl/shared.md).
         reg  [(NP-L)*A_W-1:0] ha;
         reg  [(NP-L)*B_W-1:0] hb;
-        reg  [PH_W-1:0]   ph;                       // phase of this cycle's operands when not 0
-        always @(posedge clk) begin
-          if (rst) begin
-            ph <= {PH_W{1'b0}};
-          end else if (in_valid) begin
-            ph <= {{(PH_W-1){1'b0}}, 1'b1};
-          end else if (ph != {PH_W{1'b0}}) begin
-            ph <= (ph == LAST) ? {PH_W{1'b0}} : ph + 1'b1;
-          end
-        end
         // the chains shifted down one slot (FOLD 2: one slot, nothing to shift)
         wire [(NP-L)*A_W-1:0] ha_sh;
         wire [(NP-L)*B_W-1:0] hb_sh;
@@ -187,7 +179,6 @@ module ts_mul_bank #(
             hb <= hb_sh;
           end
         end
-        wire act = in_valid | (ph != {PH_W{1'b0}});
 
         // at the multiplier outputs: a product of this operation (shift it in; the shift at the last
         // phase comes after the one cycle in which out_p is read)
@@ -205,17 +196,16 @@ module ts_mul_bank #(
           // Products of the phases before the last, held in a shift chain (phase c at [c*P_W] in
           // the cycle the last phase's product is out, which passes straight through): each
           // product bit drives one register, not FOLD - 1.
-          reg [(FOLD-1)*P_W-1:0] hp;
+          reg  [(FOLD-1)*P_W-1:0] hp;
+          wire [(FOLD-1)*P_W-1:0] hp_sh;      // p_l shifted in (FOLD 2: one slot)
           if (FOLD > 2) begin : g_chain
-            always @(posedge clk) begin
-              if (rst) hp <= {((FOLD-1)*P_W){1'b0}};
-              else if (o_shift) hp <= {p_l, hp[(FOLD-1)*P_W-1:P_W]};
-            end
+            assign hp_sh = {p_l, hp[(FOLD-1)*P_W-1:P_W]};
           end else begin : g_one
-            always @(posedge clk) begin
-              if (rst) hp <= {P_W{1'b0}};
-              else if (o_shift) hp <= p_l;
-            end
+            assign hp_sh = p_l;
+          end
+          always @(posedge clk) begin
+            if (rst) hp <= {((FOLD-1)*P_W){1'b0}};
+            else if (o_shift) hp <= hp_sh;
           end
           for (c = 0; c < FOLD; c = c + 1) begin : g_o
             if (c*L + l < N) begin : g_used
