@@ -83,21 +83,35 @@ module ts_mul_bank #(
         else if (ph != {PH_W{1'b0}}) ph <= (ph == LAST) ? {PH_W{1'b0}} : ph + 1'b1;
       end
       wire act = in_valid | (ph != {PH_W{1'b0}});
+      // held operands of phases 1 .. FOLD-1 (slot c of lane l at [((c-1)*L+l)*W]), loaded at
+      // in_valid and reset to zero, so the products are defined before the first operation; with
+      // CHAIN = 1 they shift down one slot per cycle (ha_sh), otherwise they stay (ha_sh = ha)
+      reg  [(NP-L)*A_W-1:0] ha;
+      reg  [(NP-L)*B_W-1:0] hb;
+      wire [(NP-L)*A_W-1:0] ha_sh;
+      wire [(NP-L)*B_W-1:0] hb_sh;
+      if (CHAIN != 0 && FOLD > 2) begin : g_sh
+        assign ha_sh = {{(L*A_W){1'b0}}, ha[(NP-L)*A_W-1:L*A_W]};
+        assign hb_sh = {{(L*B_W){1'b0}}, hb[(NP-L)*B_W-1:L*B_W]};
+      end else begin : g_hold
+        assign ha_sh = ha;
+        assign hb_sh = hb;
+      end
+      always @(posedge clk) begin
+        if (rst) begin
+          ha <= {((NP-L)*A_W){1'b0}};
+          hb <= {((NP-L)*B_W){1'b0}};
+        end else if (in_valid) begin
+          ha <= pa[NP*A_W-1:L*A_W];
+          hb <= pb[NP*B_W-1:L*B_W];
+        end else if (ph != {PH_W{1'b0}}) begin
+          ha <= ha_sh;
+          hb <= hb_sh;
+        end
+      end
       if (CHAIN == 0) begin : g_select
         // one copy of the held operands, a FOLD:1 ts_sel per multiplier input; the products of the
         // phases before the last captured in a register per slot
-        // held operands of phases 1 .. FOLD-1 (slot s at [(s-L)*W])
-        reg  [(NP-L)*A_W-1:0] ha;
-        reg  [(NP-L)*B_W-1:0] hb;
-        always @(posedge clk) begin
-          if (rst) begin
-            ha <= {((NP-L)*A_W){1'b0}};
-            hb <= {((NP-L)*B_W){1'b0}};
-          end else if (in_valid) begin
-            ha <= pa[NP*A_W-1:L*A_W];
-            hb <= pb[NP*B_W-1:L*B_W];
-          end
-        end
         wire [PH_W-1:0] sel = in_valid ? {PH_W{1'b0}} : ph;
 
         // phase of the products at the multiplier outputs
@@ -147,39 +161,11 @@ module ts_mul_bank #(
           end
         end
       end else begin : g_chains
-        // shift chains for the held operands and products (CHAIN = 1)
-        // Operands of phases 1 .. FOLD-1, held in one shift chain per lane (slot c of lane l at
-        // [((c-1)*L+l)*W]): loaded in parallel at in_valid, then shifted down one slot per cycle, so
-        // the multiplier always reads slot 1 (or, in the in_valid cycle, the input).  A 2:1
+        // shift chains for the held operands (ha, hb above) and products (CHAIN = 1): the
+        // multiplier always reads the chain's head (or, in the in_valid cycle, the input).  A 2:1
         // multiplexer per held bit and one per multiplier operand bit, with wires between
         // neighbouring slots only, instead of a FOLD:1 multiplexer tree in front of each multiplier
         // (docs/rtl/shared.md).
-        reg  [(NP-L)*A_W-1:0] ha;
-        reg  [(NP-L)*B_W-1:0] hb;
-        // the chains shifted down one slot (FOLD 2: one slot, nothing to shift)
-        wire [(NP-L)*A_W-1:0] ha_sh;
-        wire [(NP-L)*B_W-1:0] hb_sh;
-        if (FOLD > 2) begin : g_sh
-          assign ha_sh = {{(L*A_W){1'b0}}, ha[(NP-L)*A_W-1:L*A_W]};
-          assign hb_sh = {{(L*B_W){1'b0}}, hb[(NP-L)*B_W-1:L*B_W]};
-        end else begin : g_hold
-          assign ha_sh = ha;
-          assign hb_sh = hb;
-        end
-        // reset to zero, so the products are defined before the first operation
-        always @(posedge clk) begin
-          if (rst) begin
-            ha <= {((NP-L)*A_W){1'b0}};
-            hb <= {((NP-L)*B_W){1'b0}};
-          end else if (in_valid) begin
-            ha <= pa[NP*A_W-1:L*A_W];
-            hb <= pb[NP*B_W-1:L*B_W];
-          end else if (ph != {PH_W{1'b0}}) begin
-            ha <= ha_sh;
-            hb <= hb_sh;
-          end
-        end
-
         // at the multiplier outputs: a product of this operation (shift it in; the shift at the last
         // phase comes after the one cycle in which out_p is read)
         wire o_shift;
