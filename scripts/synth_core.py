@@ -407,8 +407,10 @@ def measure_cycles(configs: list[str]) -> dict:
 def pnr_logs(d: Path) -> dict:
     """What the nextpnr logs of a run (one per seed) say: the device, the post-route Fmax of every
     seed whose routing finished, the worst post-placement estimate, and for an unfinished route
-    how many arcs were left; placed logic cells (TRELLIS_COMB)."""
-    out: dict = {"fmax": [], "fmax_placed": None, "route_progress": None, "device": None, "comb": None}
+    how many arcs were left (placed_only: a placement whose routing was not run, nextpnr --no-route);
+    placed logic cells (TRELLIS_COMB)."""
+    out: dict = {"fmax": [], "fmax_placed": None, "route_progress": None, "device": None, "comb": None,
+                 "placed_only": False}
     for log in sorted((ROOT / d).glob("pnr_*_seed*.log")):
         text = log.read_text()
         out["device"] = log.name.split("_")[1]
@@ -420,6 +422,8 @@ def pnr_logs(d: Path) -> dict:
             cp = critical_path(text)
             if cp and (out.get("path") is None or cp["ns"] > out["path"]["ns"]):
                 out["path"] = cp
+        elif not re.search(r"Routing globals|Running router|Running main router loop|^Info: Routing\.\.|iter=\d+", text, re.M):
+            out["placed_only"] = True                # nextpnr --no-route: placement and its estimate only
         else:
             arcs = re.findall(r"Routing (\d+) arcs", text)
             left = re.findall(r"^Info:\s+\d+ \|\s+\d+\s+\d+ \|\s+\d+\s+\d+ \|\s+(\d+)\|", text, re.M)
@@ -472,8 +476,9 @@ def placed_note(r: dict, goal_dev: str) -> str:
     if r.get("fmax"):
         return f"placed and routed on {r['device']}" + ("" if r["device"] == goal_dev else f", not on {goal_dev}")
     if r.get("fmax_placed") or r.get("comb"):
-        return f"nextpnr on {r['device']}: {r['comb']:,} TRELLIS_COMB; routing not finished" if r.get("comb") else \
-            f"nextpnr on {r['device']}: routing not finished"
+        how = "placed, routing not run" if r.get("placed_only") else "routing not finished"
+        return f"nextpnr on {r['device']}: {r['comb']:,} TRELLIS_COMB; {how}" if r.get("comb") else \
+            f"nextpnr on {r['device']}: {how}"
     return "not yet placed and routed"
 
 
@@ -540,7 +545,9 @@ def section(res: dict, cycles: dict) -> str:
             fs = (f"routing not finished ({rp[1]:,} of {rp[0]:,} arcs left when stopped); post-placement estimate "
                   f"{r['fmax_placed']:.1f}" if rp else
                   f"routing not finished (router2 stopped at iteration {ro[0]} with {ro[1]:,} wires overused); "
-                  f"post-placement estimate {r['fmax_placed']:.1f}" if ro else f"post-placement estimate {r['fmax_placed']:.1f}")
+                  f"post-placement estimate {r['fmax_placed']:.1f}" if ro else
+                  f"placed, routing not run (`--no-route`); post-placement estimate {r['fmax_placed']:.1f}"
+                  if r.get("placed_only") else f"post-placement estimate {r['fmax_placed']:.1f}")
         else:
             if not any(ok for _, ok in r["fits"]):
                 fs = "not placed (does not fit)"
@@ -562,8 +569,9 @@ def section(res: dict, cycles: dict) -> str:
                              f"{cfg} configuration, 2 sweeps")
             elif r.get("fmax_placed"):
                 fp = r["fmax_placed"]
+                why = "routing not run" if r.get("placed_only") else "routing did not finish"
                 lines.append(f"{n}-joint tick: {c / fp * 1e3:.0f} ns per tick ({c} cycles at {fp:.1f} MHz, {r['device']} -6, "
-                             f"post-placement estimate: routing did not finish), {cfg} configuration, 2 sweeps")
+                             f"post-placement estimate: {why}), {cfg} configuration, 2 sweeps")
             else:
                 why = (f"it does not fit LFE5U-85F: {', '.join(over(r['total'], 'LFE5U-85F'))}"
                        if over(r["total"], "LFE5U-85F") else "place and route not run")

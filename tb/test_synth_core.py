@@ -122,6 +122,29 @@ def test_pnr_logs_router2_progress(tmp_path, monkeypatch):
     assert r["device"] == "LFE5U-85F"
 
 
+
+def test_pnr_logs_placement_only(tmp_path, monkeypatch):
+    """A placement without routing (nextpnr --no-route) is reported as such: its estimate, and the
+    words "routing not run", not "routing not finished"; a started router is not placement only."""
+    monkeypatch.setattr(synth_core, "ROOT", tmp_path)
+    log = tmp_path / "pnr_LFE5U-85F_seed1.log"
+    log.write_text("Info: \t        TRELLIS_COMB:   58407/  83640    69%\n"
+                   "Info: Max frequency for clock 'clk': 36.90 MHz (FAIL at 200.00 MHz)\n"
+                   "Info: Program finished normally.\n")
+    r = synth_core.pnr_logs(Path("."))
+    assert r["placed_only"] and r["fmax"] == [] and r["fmax_placed"] == 36.9 and r["comb"] == 58407
+    assert synth_core.placed_note(r, "LFE5U-85F") == "nextpnr on LFE5U-85F: 58,407 TRELLIS_COMB; placed, routing not run"
+    res = {"default": {**r, "fits": [(1, False), (2, False), (3, True)], "engines": {},
+                       "total": {"LUT4": 1, "CCU2C": 0, "FF": 1, "MULT18X18D": 1, "EBR": 0, "DPR16X4": 0}},
+           "_cmd": "x", "_date": "d"}
+    text = synth_core.section(res, {"default": {6: {2: 1344, 10: 3360}, 7: {2: 1515, 10: 3867}}})
+    assert "placed, routing not run (`--no-route`); post-placement estimate 36.9" in text
+    assert "6-joint tick: 36423 ns per tick (1344 cycles at 36.9 MHz, LFE5U-85F -6, post-placement estimate: " \
+           "routing not run)" in text
+    assert "routing not finished" not in text and "did not finish" not in text
+    log.write_text(log.read_text().replace("Info: Program", "Info: Running router2...\nInfo: Program"))
+    assert not synth_core.pnr_logs(Path("."))["placed_only"]
+
 LSR_RTL = """module t(input wire clk, input wire rst, input wire clr, input wire en, input wire [7:0] d,
          output reg [7:0] a, output reg f);
   always @(posedge clk) begin
