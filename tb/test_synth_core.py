@@ -122,7 +122,6 @@ def test_pnr_logs_router2_progress(tmp_path, monkeypatch):
     assert r["device"] == "LFE5U-85F"
 
 
-
 def test_pnr_logs_placement_only(tmp_path, monkeypatch):
     """A placement without routing (nextpnr --no-route) is reported as such: its estimate, and the
     words "routing not run", not "routing not finished"; a started router is not placement only."""
@@ -144,6 +143,7 @@ def test_pnr_logs_placement_only(tmp_path, monkeypatch):
     assert "routing not finished" not in text and "did not finish" not in text
     log.write_text(log.read_text().replace("Info: Program", "Info: Running router2...\nInfo: Program"))
     assert not synth_core.pnr_logs(Path("."))["placed_only"]
+
 
 LSR_RTL = """module t(input wire clk, input wire rst, input wire clr, input wire en, input wire [7:0] d,
          output reg [7:0] a, output reg f);
