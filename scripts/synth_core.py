@@ -13,7 +13,7 @@ is reported with the count that does not fit; nothing is placed then.
     .venv/bin/python scripts/synth_core.py                    # both configurations -> docs/resources.md
     .venv/bin/python scripts/synth_core.py --configs compact --seeds 1
     .venv/bin/python scripts/synth_core.py --configs default --engines   # + each engine placed alone
-    .venv/bin/python scripts/synth_core.py --place-on LFE5U-85F           # make synth-core
+    .venv/bin/python scripts/synth_core.py --place-on LFE5U-85F --route-minutes 60   # make synth-core
     .venv/bin/python scripts/synth_core.py --configs compact --place-on LFE5U-45F --lut-resets-below 5
 
 The configurations run side by side. router2 is the default router: it routed the whole compact
@@ -274,12 +274,52 @@ def nextpnr_cmd(dev_opt: str, js: Path, seed: int, log: Path, router: str = DEFA
             *extra, "--json", str(js), "--lpf-allow-unconstrained", "-l", str(log)]
 
 
+#: a nextpnr log line that shows the router has started (placement is over)
+ROUTING_STARTED = re.compile(r"Routing globals|Running router|Running main router loop|^Info: Routing\.\.|iter=\d+", re.M)
+
+
+def run_pnr(cmd: list[str], log: Path, route_minutes: float | None = None, poll: float = 10.0,
+            timeout: float = 6 * 3600) -> float | None:
+    """Run one nextpnr command that writes its log to `log` (relative to ROOT).  route_minutes: stop
+    it (kill its process group) once it has routed that long, counted from the first log line of the
+    router, so a slow placement does not eat the budget; the log is kept, and pnr_logs reports the
+    routing as not finished.  Returns the minutes it had routed when stopped, None when it ended by
+    itself.  A run longer than `timeout` seconds in all is an error."""
+    path = ROOT / log
+    t0, t_route = time.monotonic(), None
+    p = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.STDOUT, start_new_session=True)
+    try:
+        while p.poll() is None:
+            now = time.monotonic()
+            if now - t0 > timeout:
+                raise RuntimeError(f"nextpnr: no result after {timeout / 3600:.1f} h, see {log}")
+            if route_minutes is not None:
+                if t_route is None and path.exists() and ROUTING_STARTED.search(path.read_text(errors="replace")):
+                    t_route = now
+                if t_route is not None and now - t_route >= route_minutes * 60:
+                    import os
+                    import signal
+                    os.killpg(p.pid, signal.SIGTERM)
+                    p.wait(timeout=60)
+                    with path.open("a") as f:
+                        f.write(f"\nsynth_core: routing stopped after {route_minutes:g} min (--route-minutes)\n")
+                    return (now - t_route) / 60
+            time.sleep(poll)
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+    return None
+
+
 def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, place_on: str | None = None,
-        density: float | None = None, lut_resets_below: int = 0) -> dict:
+        density: float | None = None, lut_resets_below: int = 0,
+        route_minutes: float | None = None) -> dict:
     """Both syntheses of one configuration, then place and route of the flattened netlist on
     `place_on` (None: the smallest device its counts fit), one run per seed.  lut_resets_below > 0:
     the flattened synthesis moves the sync resets of fewer flip-flops than that into the LUTs
-    (mark_small_resets)."""
+    (mark_small_resets).  route_minutes: each nextpnr run's routing is stopped after that long
+    (run_pnr); None: no limit."""
     d = WORK / f"ts_servo_core_{cfg}"
     (ROOT / d).mkdir(parents=True, exist_ok=True)
     js, stat, flat_stat = d / "ecp5.json", d / "ecp5_stat.txt", d / "ecp5_flat_stat.txt"
@@ -314,7 +354,8 @@ def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, pla
     if pnr and fit:
         opt, dev = fit[0]
         for seed in seeds:
-            sh(nextpnr_cmd(opt, js, seed, d / f"pnr_{dev}_seed{seed}.log", router, density), timeout=6 * 3600)
+            run_pnr(nextpnr_cmd(opt, js, seed, d / f"pnr_{dev}_seed{seed}.log", router, density),
+                    d / f"pnr_{dev}_seed{seed}.log", route_minutes)
     r.update(pnr_logs(d))
     return r
 
@@ -410,7 +451,7 @@ def pnr_logs(d: Path) -> dict:
     how many arcs were left (placed_only: a placement whose routing was not run, nextpnr --no-route);
     placed logic cells (TRELLIS_COMB)."""
     out: dict = {"fmax": [], "fmax_placed": None, "route_progress": None, "device": None, "comb": None,
-                 "placed_only": False}
+                 "placed_only": False, "route_stopped_min": None}
     for log in sorted((ROOT / d).glob("pnr_*_seed*.log")):
         text = log.read_text()
         out["device"] = log.name.split("_")[1]
@@ -422,7 +463,7 @@ def pnr_logs(d: Path) -> dict:
             cp = critical_path(text)
             if cp and (out.get("path") is None or cp["ns"] > out["path"]["ns"]):
                 out["path"] = cp
-        elif not re.search(r"Routing globals|Running router|Running main router loop|^Info: Routing\.\.|iter=\d+", text, re.M):
+        elif not ROUTING_STARTED.search(text):
             out["placed_only"] = True                # nextpnr --no-route: placement and its estimate only
         else:
             arcs = re.findall(r"Routing (\d+) arcs", text)
@@ -432,6 +473,9 @@ def pnr_logs(d: Path) -> dict:
             r2 = re.findall(r"iter=(\d+) wires=\d+ overused=(\d+)", text)     # router2
             if r2:
                 out["route_overused"] = (int(r2[-1][0]), int(r2[-1][1]))
+            m = re.search(r"^synth_core: routing stopped after ([\d.]+) min", text, re.M)
+            if m:
+                out["route_stopped_min"] = float(m.group(1))
         m = re.search(r"TRELLIS_COMB:\s+(\d+)/", text)
         out["comb"] = int(m.group(1)) if m else out["comb"]
     return out
@@ -542,9 +586,10 @@ def section(res: dict, cycles: dict) -> str:
             fs = f"{min(f):.1f} worst of {len(f)} seed(s)"
         elif r.get("fmax_placed"):
             rp, ro = r.get("route_progress"), r.get("route_overused")
-            fs = (f"routing not finished ({rp[1]:,} of {rp[0]:,} arcs left when stopped); post-placement estimate "
+            by = (f" after {r['route_stopped_min']:g} min by `--route-minutes`" if r.get("route_stopped_min") else "")
+            fs = (f"routing not finished ({rp[1]:,} of {rp[0]:,} arcs left when stopped{by}); post-placement estimate "
                   f"{r['fmax_placed']:.1f}" if rp else
-                  f"routing not finished (router2 stopped at iteration {ro[0]} with {ro[1]:,} wires overused); "
+                  f"routing not finished (router2 stopped{by} at iteration {ro[0]} with {ro[1]:,} wires overused); "
                   f"post-placement estimate {r['fmax_placed']:.1f}" if ro else
                   f"placed, routing not run (`--no-route`); post-placement estimate {r['fmax_placed']:.1f}"
                   if r.get("placed_only") else f"post-placement estimate {r['fmax_placed']:.1f}")
@@ -641,6 +686,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="flattened netlist: sync resets shared by fewer than N flip-flops go into the LUTs, not the "
                          "slice's LSR (one LSR per slice pair; a lone reset net blocks nextpnr's legaliser on a full "
                          "part); default 0 = off")
+    ap.add_argument("--route-minutes", type=float, default=None, metavar="M",
+                    help="stop each nextpnr run after M minutes of routing (counted from the router's start) and "
+                         "report the routing as not finished, with its last router2 iteration; default: no limit")
     ap.add_argument("--place-on", choices=[dev for _, dev, *_ in DEVICES],
                     help="place every configuration on this device (default: the smallest its counts fit)")
     ap.add_argument("--engines", action="store_true",
@@ -653,6 +701,8 @@ def main(argv: list[str] | None = None) -> int:
     a = ap.parse_args(argv)
     if a.lut_resets_below < 0:
         ap.error(f"--lut-resets-below: {a.lut_resets_below} is negative")
+    if a.route_minutes is not None and a.route_minutes <= 0:
+        ap.error(f"--route-minutes: {a.route_minutes:g} is not positive")
     if a.doc_only:
         res = json.loads((ROOT / a.json).read_text())
         for cfg in ("default", "compact"):       # the per-engine sums from the stat files of the run
@@ -675,7 +725,7 @@ def main(argv: list[str] | None = None) -> int:
     from concurrent.futures import ThreadPoolExecutor
     with ThreadPoolExecutor(max_workers=len(a.configs)) as ex:
         futs = {cfg: ex.submit(run, cfg, a.seeds, not a.no_pnr, a.router, a.place_on, a.density,
-                                a.lut_resets_below) for cfg in a.configs}
+                                a.lut_resets_below, a.route_minutes) for cfg in a.configs}
         for cfg, fut in futs.items():
             res[cfg] = fut.result()
             res[cfg]["router"], res[cfg]["place_on"], res[cfg]["density"] = a.router, a.place_on, a.density

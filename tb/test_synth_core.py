@@ -1,6 +1,7 @@
 """scripts/synth_core.py: reading nextpnr's critical path report (the last one in the log, which is
 the post-route one), on a log excerpt in nextpnr 0.11's format written for the test."""
 import sys
+import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -143,6 +144,59 @@ def test_pnr_logs_placement_only(tmp_path, monkeypatch):
     assert "routing not finished" not in text and "did not finish" not in text
     log.write_text(log.read_text().replace("Info: Program", "Info: Running router2...\nInfo: Program"))
     assert not synth_core.pnr_logs(Path("."))["placed_only"]
+
+
+FAKE_NEXTPNR = """import sys, time
+log, place_s, route_s = open(sys.argv[1], "w", buffering=1), float(sys.argv[2]), float(sys.argv[3])
+log.write("Info: Max frequency for clock 'clk': 36.90 MHz (FAIL at 200.00 MHz)\\n")
+time.sleep(place_s)                                 # placement: not counted in the routing budget
+log.write("Info: Running main router loop...\\n")
+t_end, i = time.time() + route_s, 0
+while time.time() < t_end:
+    i += 1
+    log.write(f"Info:     iter={i} wires=100 overused={1000 - i} overuse=1 archfail=NA\\n")
+    time.sleep(0.1)
+log.write("Info: Routing complete.\\nInfo: Max frequency for clock 'clk': 40.00 MHz (FAIL at 200.00 MHz)\\n")
+"""
+
+
+def _fake_nextpnr(tmp_path, place_s, route_s):
+    """A stand-in for nextpnr: writes a log like nextpnr's, places for place_s seconds, routes for route_s."""
+    script = tmp_path / "fake_nextpnr.py"
+    script.write_text(FAKE_NEXTPNR)
+    return [sys.executable, str(script), "pnr_LFE5U-85F_seed1.log", str(place_s), str(route_s)]
+
+
+def test_route_minutes_stops_a_long_routing(tmp_path, monkeypatch):
+    """--route-minutes: a routing longer than the budget is stopped, its log kept and marked, and the
+    run reported as not finished after that budget, with router2's last iteration."""
+    monkeypatch.setattr(synth_core, "ROOT", tmp_path)
+    cmd = _fake_nextpnr(tmp_path, 0.0, 60.0)
+    t0 = time.monotonic()
+    stopped = synth_core.run_pnr(cmd, Path("pnr_LFE5U-85F_seed1.log"), route_minutes=0.02, poll=0.1)
+    assert stopped is not None and 0.02 <= stopped < 0.2
+    assert time.monotonic() - t0 < 20
+    r = synth_core.pnr_logs(Path("."))
+    assert r["fmax"] == [] and r["route_stopped_min"] == 0.02 and r["route_overused"][0] >= 5
+    res = {"default": {**r, "fits": [(1, False), (2, False), (3, True)], "engines": {},
+                       "total": {"LUT4": 1, "CCU2C": 0, "FF": 1, "MULT18X18D": 1, "EBR": 0, "DPR16X4": 0}},
+           "_cmd": "x", "_date": "d"}
+    text = synth_core.section(res, {"default": {6: {2: 1344, 10: 3360}, 7: {2: 1515, 10: 3867}}})
+    assert (f"routing not finished (router2 stopped after 0.02 min by `--route-minutes` at iteration "
+            f"{r['route_overused'][0]} with") in text
+
+
+def test_route_minutes_counts_from_the_router(tmp_path, monkeypatch):
+    """The budget starts when the router starts: a placement longer than the budget, then a short
+    routing, runs to its end and is reported routed; without a budget nothing is stopped."""
+    monkeypatch.setattr(synth_core, "ROOT", tmp_path)
+    cmd = _fake_nextpnr(tmp_path, 2.5, 0.5)
+    assert synth_core.run_pnr(cmd, Path("pnr_LFE5U-85F_seed1.log"), route_minutes=0.02, poll=0.1) is None
+    r = synth_core.pnr_logs(Path("."))
+    assert r["fmax"] == [40.0] and r["route_stopped_min"] is None
+    cmd = _fake_nextpnr(tmp_path, 0.0, 0.5)
+    assert synth_core.run_pnr(cmd, Path("pnr_LFE5U-85F_seed1.log"), poll=0.1) is None
+    assert synth_core.pnr_logs(Path("."))["fmax"] == [40.0]
 
 
 LSR_RTL = """module t(input wire clk, input wire rst, input wire clr, input wire en, input wire [7:0] d,
