@@ -29,8 +29,10 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import re
 import shutil
+import signal
 import subprocess
 import sys
 import time
@@ -297,8 +299,6 @@ def run_pnr(cmd: list[str], log: Path, route_minutes: float | None = None, poll:
                 if t_route is None and path.exists() and ROUTING_STARTED.search(path.read_text(errors="replace")):
                     t_route = now
                 if t_route is not None and now - t_route >= route_minutes * 60:
-                    import os
-                    import signal
                     os.killpg(p.pid, signal.SIGTERM)
                     p.wait(timeout=60)
                     with path.open("a") as f:

@@ -199,6 +199,18 @@ def test_route_minutes_counts_from_the_router(tmp_path, monkeypatch):
     assert synth_core.pnr_logs(Path("."))["fmax"] == [40.0]
 
 
+def test_route_minutes_must_be_positive(capsys):
+    """--route-minutes 0 or below is refused with one line naming the option, before any synthesis."""
+    for bad in ("0", "-5"):
+        try:
+            synth_core.main(["--route-minutes", bad, "--json", "/nonexistent/x.json"])
+        except SystemExit as e:
+            assert e.code != 0
+        else:
+            raise AssertionError(f"--route-minutes {bad} was accepted")
+        assert f"--route-minutes: {float(bad):g} is not positive" in capsys.readouterr().err
+
+
 LSR_RTL = """module t(input wire clk, input wire rst, input wire clr, input wire en, input wire [7:0] d,
          output reg [7:0] a, output reg f);
   always @(posedge clk) begin
