@@ -354,8 +354,8 @@ def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, pla
     if pnr and fit:
         opt, dev = fit[0]
         for seed in seeds:
-            run_pnr(nextpnr_cmd(opt, js, seed, d / f"pnr_{dev}_seed{seed}.log", router, density),
-                    d / f"pnr_{dev}_seed{seed}.log", route_minutes)
+            log = d / f"pnr_{dev}_seed{seed}.log"
+            run_pnr(nextpnr_cmd(opt, js, seed, log, router, density), log, route_minutes)
     r.update(pnr_logs(d))
     return r
 
