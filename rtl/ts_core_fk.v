@@ -27,8 +27,9 @@
 // evaluation: out_busy until out_done (one-cycle pulse); the results then hold until the next
 // start: tool pose (out_tool_*), and through the column port (registered: in_col_addr sampled
 // at a clock edge, out_col_* valid after it) column j of J (omega: jw_t, v: jv_t) and the
-// origin p_{j+1} of joint frame j+1 (pos_t).  out_sat: the model raised a saturation flag in this
-// evaluation (valid with out_done and after it).
+// origin p_{j+1} of joint frame j+1 (pos_t).  out_flags: the model's Status bits of this
+// evaluation (ST_OVF_TRIG, ST_OVF_QUAT, ST_OVF_POS, ST_OVF_LEVER, ST_OVF_JAC: bits 2-6; valid with
+// out_done and after it).
 // Widths: every *_W parameter below is derived from CONFIG (0 default, 1 compact); do not override.
 // Language: Verilog 2005
 `resetall
@@ -79,7 +80,7 @@ module ts_core_fk #(
   input  wire                    in_start,
   output reg                     out_busy,
   output reg                     out_done,
-  output reg                     out_sat,
+  output reg  [15:0]             out_flags,
   // tool pose (root frame)
   output reg  signed [Q_W-1:0]   out_tool_q_w,
   output reg  signed [Q_W-1:0]   out_tool_q_x,
@@ -288,7 +289,7 @@ module ts_core_fk #(
   assign pre_j = pre_in[JI_W-1:0];
   wire            jq_valid;
   wire signed [Q_W-1:0] jq_o [0:3];
-  wire            jq_sat;
+  wire [15:0]     jq_flags;
   ts_joint_quat #(
     .ANG_W(ANG_W), .ANG_F(A_F), .KT_W(KT_W), .KT_F(TS_KTURN_F), .U_W(TS_TURN_W),
     .T_BITS(TS_TRIG_TABLE_BITS), .TAB_W(TS_TAB_W), .TAB_F(TS_TAB_F), .DELTA_W(TS_DELTA_W),
@@ -300,7 +301,7 @@ module ts_core_fk #(
     .clk(clk), .rst(rst), .in_valid(pre_valid), .in_angle(q_pre), .in_kturn(k_pre),
     .in_axis_x(ax_pre[0]), .in_axis_y(ax_pre[1]), .in_axis_z(ax_pre[2]),
     .out_valid(jq_valid), .out_w(jq_o[0]), .out_x(jq_o[1]), .out_y(jq_o[2]), .out_z(jq_o[3]),
-    .out_sat(jq_sat));
+    .out_flags(jq_flags));
 
   // d = cvt<lever_t>(s q)
   localparam MLD = ts_mul_lat(S_W, ANG_W);
@@ -366,7 +367,8 @@ module ts_core_fk #(
   reg st_valid;
   reg [JI_W-1:0] st_j;
   reg st_fk;                 // 1: the FK use (prismatic z, lever inputs zero)
-  wire st_ovalid, st_sat;
+  wire st_ovalid;
+  wire [15:0] st_flags;
   wire signed [Q_W-1:0] st_z [0:2];
   wire signed [JW_W-1:0] st_w [0:2];
   wire signed [JV_W-1:0] st_v [0:2];
@@ -401,7 +403,7 @@ module ts_core_fk #(
     .in_pi_x(st_pi[0]), .in_pi_y(st_pi[1]), .in_pi_z(st_pi[2]),
     .out_valid(st_ovalid), .out_z_x(st_z[0]), .out_z_y(st_z[1]), .out_z_z(st_z[2]),
     .out_w_x(st_w[0]), .out_w_y(st_w[1]), .out_w_z(st_w[2]),
-    .out_v_x(st_v[0]), .out_v_y(st_v[1]), .out_v_z(st_v[2]), .out_sat(st_sat));
+    .out_v_x(st_v[0]), .out_v_y(st_v[1]), .out_v_z(st_v[2]), .out_flags(st_flags));
 
   // ---- prismatic origin p_i = cvt<pos_t>(pF + d z) ----------------------------------------------------
   localparam MLP = ts_bank_lat(L_W, Q_W, FOLD);
@@ -453,6 +455,17 @@ module ts_core_fk #(
   endgenerate
   wire last_col_in = (col_in[JI_W-1:0] == n_m1);
 
+  // the model's Status bits raised this cycle (each result is used, so each flag counts): the
+  // joint quaternion of a revolute joint (TRIG, QUAT) and d = s q of a prismatic one (LEVER),
+  // the shared quaternion product (QUAT), rotated offset and sum (POS: len_tmp_t, pos_t), the
+  // screw transport (QUAT, LEVER, JAC) and the prismatic origin (POS)
+  localparam ST_QUAT = 3, ST_POS = 4, ST_LEVER = 5;
+  wire [15:0] fl_set = ((jq_valid && !c_pr[jq_j]) ? jq_flags : 16'd0)
+                     | (st_ovalid ? st_flags : 16'd0)
+                     | ({15'd0, d_valid && c_pr[d_j] && d_sat} << ST_LEVER)
+                     | ({15'd0, qm_ovalid && qm_sat} << ST_QUAT)
+                     | ({15'd0, (add_valid && (ro_sat_d || (|add_sat))) || (pp_ovalid && (|pp_sat))} << ST_POS);
+
   always @(posedge clk) begin
     if (rst) begin
       state <= S_IDLE;
@@ -474,7 +487,7 @@ module ts_core_fk #(
       pp_valid <= 1'b0;
       out_busy <= 1'b0;
       out_done <= 1'b0;
-      out_sat <= 1'b0;
+      out_flags <= 16'd0;
       out_tool_q_w <= {Q_W{1'b0}}; out_tool_q_x <= {Q_W{1'b0}};
       out_tool_q_y <= {Q_W{1'b0}}; out_tool_q_z <= {Q_W{1'b0}};
       out_tool_p_x <= {P_W{1'b0}}; out_tool_p_y <= {P_W{1'b0}}; out_tool_p_z <= {P_W{1'b0}};
@@ -501,17 +514,12 @@ module ts_core_fk #(
       if (pre_valid) pre_in <= pre_in + 1'b1;
       if (jq_valid) begin
         jq_cnt <= jq_cnt + 1'b1;
-        if (jq_sat && !c_pr[jq_j]) out_sat <= 1'b1;
       end
       if (d_valid) begin
         d_cnt <= d_cnt + 1'b1;
-        if (d_sat && c_pr[d_j]) out_sat <= 1'b1;
       end
       // flags of the shared units (each result is used, so each flag counts)
-      if (qm_ovalid && qm_sat) out_sat <= 1'b1;
-      if (add_valid && (ro_sat_d || (|add_sat))) out_sat <= 1'b1;
-      if (st_ovalid && st_sat) out_sat <= 1'b1;
-      if (pp_ovalid && (|pp_sat)) out_sat <= 1'b1;
+      out_flags <= out_flags | fl_set;
       // pF of the current step, whatever the state
       if (add_valid) begin
         have_pf <= 1'b1;
@@ -522,7 +530,7 @@ module ts_core_fk #(
         S_IDLE: begin
           if (in_start) begin
             out_busy <= 1'b1;
-            out_sat <= 1'b0;
+            out_flags <= 16'd0;
             pre_in <= {(JI_W+1){1'b0}};
             jq_cnt <= {(JI_W+1){1'b0}};
             d_cnt <= {(JI_W+1){1'b0}};

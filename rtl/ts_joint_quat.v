@@ -6,7 +6,8 @@
 //   out = (cs, cvt<quat_t>(sn * axis))    (cos(theta/2), sin(theta/2) a), theta = s q
 // angle in angle_t (ANG_W, ANG_F), kturn = s / (4 pi) in kturn_t (KT_W, KT_F), axis and output in
 // quat_t.  Latency ts_mul_lat(ANG_W, KT_W) + 2 + ts_sincos latency + ts_mul_lat(Q_W, Q_W) + 2,
-// II = 1.  out_sat = 1 when sincos or an output component saturated.
+// II = 1.  out_flags: the model's Status bits, ts_sincos's (ST_OVF_TRIG, ST_OVF_QUAT) and
+// ST_OVF_QUAT (bit 3) when an output component saturated.
 // Language: Verilog 2005
 `resetall
 `timescale 1ns / 1ps
@@ -75,7 +76,7 @@ module ts_joint_quat #(
   output wire signed [Q_W-1:0]   out_x,
   output wire signed [Q_W-1:0]   out_y,
   output wire signed [Q_W-1:0]   out_z,
-  output wire                    out_sat
+  output wire             [15:0] out_flags
 );
 
   `include "ts_common.vh"
@@ -106,7 +107,7 @@ module ts_joint_quat #(
   ts_delay #(.W(1), .DEPTH(C_U)) u_uv (.clk(clk), .rst(rst), .din(in_valid), .dout(wrap_valid));
   wire sc_valid;
   wire signed [Q_W-1:0] sn, cs;
-  wire sc_sat;
+  wire [15:0] sc_flags;
   ts_sincos #(
     .U_W(U_W), .T_BITS(T_BITS), .TAB_W(TAB_W), .TAB_F(TAB_F), .DELTA_W(DELTA_W), .DELTA_F(DELTA_F),
     .DSQ_W(DSQ_W), .DSQ_F(DSQ_F), .ACC_W(ACC_W), .ACC_F(ACC_F), .Q_W(Q_W), .Q_F(Q_F),
@@ -114,7 +115,7 @@ module ts_joint_quat #(
     .SIXTH(SIXTH), .ROM_FILE(ROM_FILE), .TARGET(TARGET)
   ) u_sincos (
     .clk(clk), .rst(rst), .in_valid(wrap_valid), .in_u(u), .out_valid(sc_valid),
-    .out_sin(sn), .out_cos(cs), .out_sat(sc_sat));
+    .out_sin(sn), .out_cos(cs), .out_flags(sc_flags));
 
   // ---- (cs, sn axis) ---------------------------------------------------------------------------
   wire [3*Q_W-1:0] axis_d;
@@ -138,9 +139,12 @@ module ts_joint_quat #(
   wire [Q_W-1:0] cs_d;
   ts_delay #(.W(Q_W), .DEPTH(MLQ+RL)) u_cd (.clk(clk), .rst(rst), .din(cs), .dout(cs_d));
   assign out_w = cs_d;
-  wire sc_sat_d;
-  ts_delay #(.W(1), .DEPTH(MLQ+RL)) u_sd (.clk(clk), .rst(rst), .din(sc_sat), .dout(sc_sat_d));
-  assign out_sat = sc_sat_d | (|sat_v);
+  // ts_sincos raises only ST_OVF_TRIG and ST_OVF_QUAT (bits 2, 3): only those are delayed
+  localparam ST_TRIG = 2, ST_QUAT = 3;
+  wire [1:0] sc_tq_d;
+  ts_delay #(.W(2), .DEPTH(MLQ+RL)) u_sd (.clk(clk), .rst(rst), .din(sc_flags[ST_QUAT:ST_TRIG]), .dout(sc_tq_d));
+  wire unused_sc_flags = &{1'b0, sc_flags[15:ST_QUAT+1], sc_flags[ST_TRIG-1:0]};
+  assign out_flags = ({15'd0, sc_tq_d[0]} << ST_TRIG) | ({15'd0, sc_tq_d[1] | (|sat_v)} << ST_QUAT);
   ts_delay #(.W(1), .DEPTH(MLQ+RL)) u_valid (.clk(clk), .rst(rst), .din(sc_valid), .dout(out_valid));
 
 endmodule

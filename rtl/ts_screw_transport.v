@@ -4,9 +4,10 @@
 //   screw_column(prismatic, s, z, p_ref, p_i):         (model/include/tensor_servo/kinematics.hpp)
 //     revolute:  w = cvt<jw_t>(s z),  r = cvt<lever_t>(p_ref - p_i),  v = cross<jv_t>(w, r)
 //     prismatic: w = 0,               v = cvt<jv_t>(s z)
-// The product s z is formed once and rounded to both jw_t and jv_t.  out_sat = 1 when the model
-// raises a saturation flag: the rotation, and for a revolute joint w, the lever arm or v (for a
-// prismatic joint v = s z); signals the model does not compute for the joint type never flag.
+// The product s z is formed once and rounded to both jw_t and jv_t.  out_flags: the model's Status
+// bits of the column: ST_OVF_QUAT (bit 3) from the rotation, ST_OVF_LEVER (bit 5) from the lever
+// arm, ST_OVF_JAC (bit 6) from w or v (for a prismatic joint v = s z); signals the model does not
+// compute for the joint type never flag.
 // Products on ts_mul_bank (FOLD products per multiplier: the rotation's 15, s z's 3 and the cross
 // product's 6).  Latency: see LATENCY (docs/rtl/ts_screw_transport.md), II = FOLD; the bits do
 // not depend on FOLD.
@@ -80,7 +81,7 @@ module ts_screw_transport #(
   output reg  signed [JV_W-1:0] out_v_x,
   output reg  signed [JV_W-1:0] out_v_y,
   output reg  signed [JV_W-1:0] out_v_z,
-  output reg                    out_sat
+  output reg             [15:0] out_flags
 );
 
   `include "ts_common.vh"
@@ -189,6 +190,7 @@ module ts_screw_transport #(
   ts_delay #(.W(3*JV_W), .DEPTH(C_V-C_W)) u_vpd (.clk(clk), .rst(rst), .din({vp[2], vp[1], vp[0]}), .dout(vp_d));
   wire pr_d;
   ts_delay #(.W(1), .DEPTH(C_V)) u_prd (.clk(clk), .rst(rst), .din(in_prismatic), .dout(pr_d));
+  localparam ST_QUAT = 3, ST_LEVER = 5, ST_JAC = 6;
   wire sat_z_d, sat_r_d, sat_w_d, sat_vp_d;
   ts_delay #(.W(1), .DEPTH(C_V-LR))  u_f0 (.clk(clk), .rst(rst), .din(z_sat),   .dout(sat_z_d));
   ts_delay #(.W(1), .DEPTH(C_V-C_R)) u_f1 (.clk(clk), .rst(rst), .din(|sat_r),  .dout(sat_r_d));
@@ -200,7 +202,7 @@ module ts_screw_transport #(
       out_z_x <= {Q_W{1'b0}};  out_z_y <= {Q_W{1'b0}};  out_z_z <= {Q_W{1'b0}};
       out_w_x <= {JW_W{1'b0}}; out_w_y <= {JW_W{1'b0}}; out_w_z <= {JW_W{1'b0}};
       out_v_x <= {JV_W{1'b0}}; out_v_y <= {JV_W{1'b0}}; out_v_z <= {JV_W{1'b0}};
-      out_sat <= 1'b0;
+      out_flags <= 16'd0;
     end else begin
       out_z_x <= z_d[Q_W-1:0];
       out_z_y <= z_d[2*Q_W-1:Q_W];
@@ -212,7 +214,9 @@ module ts_screw_transport #(
         out_v_x <= vp_d[JV_W-1:0];
         out_v_y <= vp_d[2*JV_W-1:JV_W];
         out_v_z <= vp_d[3*JV_W-1:2*JV_W];
-        out_sat <= sat_z_d | sat_vp_d;
+        out_flags <= 16'd0;
+        out_flags[ST_QUAT] <= sat_z_d;
+        out_flags[ST_JAC] <= sat_vp_d;
       end else begin
         out_w_x <= w_d[JW_W-1:0];
         out_w_y <= w_d[2*JW_W-1:JW_W];
@@ -220,7 +224,10 @@ module ts_screw_transport #(
         out_v_x <= vc[0];
         out_v_y <= vc[1];
         out_v_z <= vc[2];
-        out_sat <= sat_z_d | sat_w_d | sat_r_d | (|sat_vc);
+        out_flags <= 16'd0;
+        out_flags[ST_QUAT] <= sat_z_d;
+        out_flags[ST_LEVER] <= sat_r_d;
+        out_flags[ST_JAC] <= sat_w_d | (|sat_vc);
       end
     end
   end

@@ -390,7 +390,8 @@ module ts_servo_core #(
   // ---- FK engine -----------------------------------------------------------------------------------
   reg fk_start;
   reg [JI_W-1:0] col_addr;
-  wire fk_busy, fk_done, fk_sat;
+  wire fk_busy, fk_done;
+  wire [15:0] fk_flags;
   wire signed [QUAT_W-1:0] tq_w, tq_x, tq_y, tq_z;
   wire signed [P_W-1:0] tp_x, tp_y, tp_z;
   wire signed [JW_W-1:0] fc_wx, fc_wy, fc_wz;
@@ -401,7 +402,7 @@ module ts_servo_core #(
     .clk(clk), .rst(rst),
     .in_cfg_we(fk_we_q), .in_cfg_addr(ld_q), .in_cfg_data(fk_cd_q),
     .in_q_we(in_prep && !psub), .in_q_addr(pjj), .in_q_data(q_sel),
-    .in_start(fk_start), .out_busy(fk_busy), .out_done(fk_done), .out_sat(fk_sat),
+    .in_start(fk_start), .out_busy(fk_busy), .out_done(fk_done), .out_flags(fk_flags),
     .out_tool_q_w(tq_w), .out_tool_q_x(tq_x), .out_tool_q_y(tq_y), .out_tool_q_z(tq_z),
     .out_tool_p_x(tp_x), .out_tool_p_y(tp_y), .out_tool_p_z(tp_z),
     .in_col_addr(col_addr),
@@ -643,8 +644,8 @@ module ts_servo_core #(
         end
         S_SOLVE: begin
           if (sv_done) begin
-            status_w <= sv_flags | {16'd0, law_flags} | {2'b00, fk_sat, 29'd0};
-            flags_set <= sv_flags[17:0] | {2'b00, law_flags};
+            status_w <= sv_flags | {16'd0, law_flags} | {16'd0, fk_flags};
+            flags_set <= sv_flags[17:0] | {2'b00, law_flags} | {2'b00, fk_flags};
             for (k = 0; k < NMAX; k = k + 1) begin
               qd_prev[k*QD_W +: QD_W] <= sv_qd[k*QD_W +: QD_W];
               q_int[k*ANGLE_W +: ANGLE_W] <= sv_qn[k*ANGLE_W +: ANGLE_W];

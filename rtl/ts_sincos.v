@@ -9,7 +9,9 @@
 //   Sh, Ch, Csd, Ssd = cvt<trig_acc_t>(S h, C h, C sd, S sd)
 //   sn = cvt<quat_t>((S - Sh) + Csd)                 cs = cvt<quat_t>((C - Ch) - Ssd)
 // then the quadrant swaps and negates (negation saturates: cvt<quat_t>(-x)).  Every cvt rounds
-// half up (AP_RND) and saturates (AP_SAT); out_sat = 1 when any of them saturated.
+// half up (AP_RND) and saturates (AP_SAT).  out_flags: the model's Status bits of the evaluation,
+// ST_OVF_TRIG (bit 2) for the internal formats delta_t, dsq_t, trig_acc_t and ST_OVF_QUAT (bit 3)
+// for the outputs' quat_t conversions and negations; the other bits are 0.
 // Latency: see LATENCY (docs/rtl/ts_sincos.md), II = 1.
 // Language: Verilog 2005
 `resetall
@@ -65,7 +67,7 @@ module ts_sincos #(
   output wire                  out_valid,
   output reg  signed [Q_W-1:0] out_sin,
   output reg  signed [Q_W-1:0] out_cos,
-  output wire                  out_sat
+  output wire           [15:0] out_flags
 );
 
   `include "ts_common.vh"
@@ -281,7 +283,8 @@ module ts_sincos #(
   ts_delay #(.W(1), .DEPTH(LATENCY-C_SD))  u_f4 (.clk(clk), .rst(rst), .din(sat_sd),     .dout(sat_at_out[4]));
   ts_delay #(.W(1), .DEPTH(LATENCY-C_ACC)) u_f5 (.clk(clk), .rst(rst), .din(|sat_acc),   .dout(sat_at_out[5]));
   ts_delay #(.W(1), .DEPTH(LATENCY-C_SC))  u_f6 (.clk(clk), .rst(rst), .din(|sat_sc),    .dout(sat_at_out[6]));
-  assign out_sat = sat_q | (|sat_at_out);
+  localparam ST_TRIG = 2, ST_QUAT = 3;
+  assign out_flags = ({15'd0, |sat_at_out[5:0]} << ST_TRIG) | ({15'd0, sat_q | sat_at_out[6]} << ST_QUAT);
 
   ts_delay #(.W(1), .DEPTH(LATENCY)) u_valid (.clk(clk), .rst(rst), .din(in_valid), .dout(out_valid));
 

@@ -40,8 +40,10 @@ struct Model final : ModelBase {
   using angle_t = typename Fmt::angle_t;
   ChainQ<Fmt, NMAX> ch;
 
-  explicit Model(const ChainSpec& spec) {
-    const ConfigResult r = configure_chain<Fmt, NMAX>(spec, ch);
+  // checked: the core's configuration rule (configure_chain). Unchecked: only the quantisation
+  // (every constant in its format), so that benches can drive chains whose kinematics saturate.
+  Model(const ChainSpec& spec, bool checked) {
+    const ConfigResult r = checked ? configure_chain<Fmt, NMAX>(spec, ch) : quantize<Fmt, NMAX>(spec, ch);
     if (!r.ok()) throw std::invalid_argument(r.field + ": " + r.message);
   }
   int n() const override { return ch.n; }
@@ -182,11 +184,11 @@ struct Model final : ModelBase {
   }
 };
 
-std::unique_ptr<ModelBase> make_model(const std::string& cfg, const py::dict& spec) {
+std::unique_ptr<ModelBase> make_model(const std::string& cfg, const py::dict& spec, bool checked) {
   const ChainSpec c = spec_from_dict(spec);
-  if (cfg == "double") return std::make_unique<Model<FmtDouble>>(c);
-  if (cfg == "default") return std::make_unique<Model<FmtDefault>>(c);
-  if (cfg == "compact") return std::make_unique<Model<FmtCompact>>(c);
+  if (cfg == "double") return std::make_unique<Model<FmtDouble>>(c, checked);
+  if (cfg == "default") return std::make_unique<Model<FmtDefault>>(c, checked);
+  if (cfg == "compact") return std::make_unique<Model<FmtCompact>>(c, checked);
   throw std::invalid_argument("config: unknown configuration '" + cfg + "' (double, default, compact)");
 }
 
@@ -342,7 +344,7 @@ PYBIND11_MODULE(_model, m) {
   bind_servo(m);
   bind_pinv(m);
   py::class_<ModelBase>(m, "Model")
-      .def(py::init(&make_model), py::arg("config"), py::arg("spec"))
+      .def(py::init(&make_model), py::arg("config"), py::arg("spec"), py::arg("checked") = true)
       .def_property_readonly("n", &ModelBase::n)
       .def("quantize_q", &ModelBase::quantize_q, py::arg("q"))
       .def("fk", &ModelBase::fk, py::arg("q"), py::arg("raw") = false)

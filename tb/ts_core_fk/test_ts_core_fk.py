@@ -1,10 +1,19 @@
 """Bench of rtl/ts_core_fk.v: forward kinematics and the screw-transport Jacobian (root basis, reference
 point the tool origin: what the servo uses for error choice A) bit for bit against the model
 (tensor_servo._model.Model(cfg, spec).jacobian(q, raw=True)): the tool pose, every joint frame's
-origin and every Jacobian column, and the saturation flag (out_sat = the model raised a flag), for
+origin and every Jacobian column, and the Status bits (out_flags = the model's flags), for
 PUMA 560, UR5, Panda, the Stanford arm (prismatic joint), PUMA 560 with a rotated and offset base
 and tool, and the first 8 joints of chain20 (NMAX joints, one prismatic), at fresh random joint
 values within the limits (seed printed; replay with TS_SEED=<seed>; TS_NQ = vectors per chain).
+Two more chains saturate, so that the flags and the saturated values are checked too: the model
+builds them without the core's configuration checks (Model(..., checked=False)), which refuse
+them: PUMA 560 with offsets (3.5, -3.5, 3.5) m and scale 3 (compact: 1.5; positions, lever arms
+and Jacobian entries saturate; in the default configuration without its origin rotations, so that
+at q = 0 the offsets add up to 21 m, beyond pos_t's 16 m) and the Stanford arm with a prismatic scale of 3.9 driven to |q| < 7.5 (d = s q
+saturates), both at joint values anywhere in the angle format (the first vector at 0.95 of the
+range on every joint; PUMA's second at zero); and the Stanford arm's first three joints with long
+offsets along z and the same prismatic scale, whose first vector saturates only the prismatic
+origin p_3 = pF + d z (`first_rows`).
 Also: no output is X after reset, busy/done protocol, the cycle count of each evaluation (logged;
 constant for a chain), and that the width localparams of the module equal the model's formats.
 """
@@ -22,7 +31,10 @@ import tsbench
 MODULE = "ts_core_fk"
 NMAX = 8
 JI_W = 3
-CHAINS = ("puma560", "ur5", "panda", "stanford", "puma560_frames", "chain20_8")
+CHAINS = ("puma560", "ur5", "panda", "stanford", "puma560_frames", "chain20_8", "puma560_reach",
+          "stanford_stroke", "stanford_pp")
+#: chains past the core's configuration checks: |q| range of their random joint values
+SATURATING = {"puma560_reach": 7.5, "stanford_stroke": 7.5, "stanford_pp": 7.5}
 
 try:
     import cocotb
@@ -30,7 +42,7 @@ except ImportError:  # pragma: no cover
     cocotb = None
 
 
-def chain_spec(name: str) -> dict:
+def chain_spec(name: str, cfg: str = "default") -> dict:
     from tensor_servo import robots
     from tensor_servo.model import model_spec
     if name == "puma560_frames":
@@ -44,13 +56,56 @@ def chain_spec(name: str) -> dict:
         sp = model_spec(robots.load("chain20"))
         sp["joints"] = sp["joints"][:NMAX]
         return sp
+    if name == "puma560_reach":
+        sp = model_spec(robots.load("puma560"))
+        for j in sp["joints"]:
+            # the largest revolute scale of each format (kturn_t: |s| < 4 pi / 2^(W-I) ...)
+            j["origin_xyz"], j["scale"] = [3.5, -3.5, 3.5], (3.0 if cfg == "default" else 1.5)
+            if cfg == "default":  # the offsets add up at q = 0: 21 m > 16 m (pos_t)
+                j["origin_quat"] = [1.0, 0.0, 0.0, 0.0]
+        return sp
+    if name == "stanford_stroke":
+        sp = model_spec(robots.load("stanford"))
+        for j in sp["joints"]:
+            if j["prismatic"]:
+                j["scale"] = 3.9
+        return sp
+    if name == "stanford_pp":
+        # the first three joints, offsets along z adding up to 8.4 m (compact 4.35 m) at frame 3's
+        # origin before the prismatic stroke: d z takes it past pos_t (16 m, compact 8 m), while no
+        # other sum saturates (the tool sits on frame 3)
+        sp = model_spec(robots.load("stanford"))
+        sp["joints"] = sp["joints"][:3]
+        big = 1.0 if cfg == "default" else 0.5
+        sp["base_xyz"] = [0.0, 0.0, 3.9 * big]
+        sp["joints"][0]["origin_xyz"] = [0.0, 0.0, 3.5 * big]
+        sp["joints"][1]["origin_xyz"] = [0.0, 0.0, 1.0 if cfg == "default" else 0.7]
+        sp["joints"][2]["scale"] = 3.9
+        return sp
     return model_spec(robots.load(name))
 
 
-def random_q(m, spec: dict, rng, nq: int) -> np.ndarray:
-    lo = np.array([j["lower"] if j["limited"] else -np.pi for j in spec["joints"]])
-    hi = np.array([j["upper"] if j["limited"] else np.pi for j in spec["joints"]])
+def first_rows(name: str, cfg: str, n: int) -> list:
+    """Fixed joint values (joint units) that the vectors of a saturating chain start with."""
+    qmax = SATURATING[name]
+    if name == "puma560_reach":
+        return [np.full(n, 0.95 * qmax), np.zeros(n)]
+    if name == "stanford_stroke":
+        return [np.full(n, 0.95 * qmax)]
+    # stanford_pp at q = 0: frame 3's z axis is the root's; d = 7.8 m (compact 3.98 m) along it
+    return [np.array([0.0, 0.0, 2.0 if cfg == "default" else 1.02])]
+
+
+def random_q(m, spec: dict, rng, nq: int, qmax: float | None = None, first: list = ()) -> np.ndarray:
+    """Raw joint values within the limits, or anywhere in (-qmax, qmax) after the rows first."""
+    if qmax is not None:
+        lo, hi = np.full(m.n, -qmax), np.full(m.n, qmax)
+    else:
+        lo = np.array([j["lower"] if j["limited"] else -np.pi for j in spec["joints"]])
+        hi = np.array([j["upper"] if j["limited"] else np.pi for j in spec["joints"]])
     q = lo + (hi - lo) * rng.random((nq, len(lo)))
+    for r, row in enumerate(first[:nq]):
+        q[r] = row
     d = m.quantize_q(q)
     assert np.asarray(d["ok"]).all()
     return np.asarray(d["q_raw"], dtype=np.int64)
@@ -102,6 +157,7 @@ if cocotb is not None:
         from cocotb.clock import Clock
         from cocotb.triggers import FallingEdge
         from tensor_servo import _model
+        from tensor_servo.model import STATUS_BITS
         cfg = os.environ["TS_CONFIG"]
         seed = int(os.environ["TS_SEED"])
         nq = int(os.environ.get("TS_NQ", "12"))
@@ -116,7 +172,7 @@ if cocotb is not None:
         await clock_cycles(dut, 4)
         dut.rst.value = 0
         await FallingEdge(dut.clk)
-        outs = [getattr(dut, f"out_{x}") for x in ["busy", "done", "sat"] + [f"tool_q_{a}" for a in "wxyz"]
+        outs = [getattr(dut, f"out_{x}") for x in ["busy", "done", "flags"] + [f"tool_q_{a}" for a in "wxyz"]
                 + [f"tool_p_{a}" for a in "xyz"] + [f"col_{g}_{a}" for g in "wvp" for a in "xyz"]]
         for h in outs:
             assert h.value.is_resolvable, f"{h._name} is {h.value.binstr} after reset"
@@ -128,9 +184,10 @@ if cocotb is not None:
         sg = tsbench.to_signed
         problems = []
         cycles_log = {}
+        raised = {name: 0 for name in CHAINS}
         for name in CHAINS:
-            spec = chain_spec(name)
-            m = _model.Model(cfg, spec)
+            spec = chain_spec(name, cfg)
+            m = _model.Model(cfg, spec, checked=name not in SATURATING)
             n = m.n
             c = m.constants()
             for addr, val in cfg_words(c):
@@ -139,7 +196,8 @@ if cocotb is not None:
                 dut.in_cfg_data.value = val & ((1 << cw) - 1)
                 await FallingEdge(dut.clk)
             dut.in_cfg_we.value = 0
-            q = random_q(m, spec, rng, nq)
+            q = random_q(m, spec, rng, nq, SATURATING.get(name),
+                         first_rows(name, cfg, n) if name in SATURATING else ())
             ref = m.jacobian(q, raw=True)
             cyc = []
             for s in range(nq):
@@ -162,7 +220,7 @@ if cocotb is not None:
                 cyc.append(k)
                 got_q = [sg(int(getattr(dut, f"out_tool_q_{a}").value), w["out_tool_q_w"]) for a in "wxyz"]
                 got_p = [sg(int(getattr(dut, f"out_tool_p_{a}").value), w["out_tool_p_x"]) for a in "xyz"]
-                got_sat = int(dut.out_sat.value)
+                got_flags = int(dut.out_flags.value) & 0xFFFF
                 J = np.zeros((6, n), dtype=np.int64)
                 P = np.zeros((n, 3), dtype=np.int64)
                 for col in range(n):
@@ -177,7 +235,8 @@ if cocotb is not None:
                 exp_p = np.asarray(ref["pos_raw"])[s, n + 1]
                 exp_P = np.asarray(ref["pos_raw"])[s, 1:n + 1]
                 exp_J = np.asarray(ref["J_raw"])[s]
-                exp_sat = int((int(ref["flags"][s]) & 0xFFFF) != 0)
+                exp_flags = int(ref["flags"][s]) & 0xFFFF
+                raised[name] |= exp_flags
                 bad = []
                 if not np.array_equal(got_q, exp_q):
                     bad.append(f"tool quat model {exp_q.tolist()} rtl {got_q}")
@@ -189,8 +248,8 @@ if cocotb is not None:
                 if not np.array_equal(J, exp_J):
                     cols = np.nonzero(np.any(J != exp_J, axis=0))[0]
                     bad.append(f"J columns {cols.tolist()} differ: model {exp_J[:, cols].T.tolist()} rtl {J[:, cols].T.tolist()}")
-                if got_sat != exp_sat:
-                    bad.append(f"out_sat {got_sat}, model flags {int(ref['flags'][s]):#x}")
+                if got_flags != exp_flags:
+                    bad.append(f"out_flags {got_flags:#x}, model flags {exp_flags:#x}")
                 if bad:
                     problems.append(f"{name} vector {s} q_raw={q[s].tolist()}: " + "; ".join(bad))
             cycles_log[name] = (n, sorted(set(cyc)))
@@ -199,6 +258,16 @@ if cocotb is not None:
             if len(set(cyc)) != 1:
                 problems.append(f"{name}: cycle count not constant: {sorted(set(cyc))}")
         dut._log.info("cycles per chain: %s", cycles_log)
+        dut._log.info("Status bits raised per chain: %s", {k: hex(v) for k, v in raised.items()})
+        for name in CHAINS:
+            if (raised[name] != 0) != (name in SATURATING):
+                problems.append(f"{name}: Status bits {raised[name]:#x} raised over its vectors")
+        sat_bits = STATUS_BITS["ovf_pos"] | STATUS_BITS["ovf_lever"] | STATUS_BITS["ovf_jac"]
+        got_bits = raised["puma560_reach"] | raised["stanford_stroke"]
+        if not raised["stanford_pp"] & STATUS_BITS["ovf_pos"]:
+            problems.append(f"stanford_pp raised {raised['stanford_pp']:#x}: its prismatic origin must saturate")
+        if got_bits & sat_bits != sat_bits:
+            problems.append(f"the saturating chains raised {got_bits:#x}: POS, LEVER and JAC must all be covered")
         out_file = os.environ.get("TS_CYCLES_FILE")
         if out_file:
             Path(out_file).write_text(json.dumps(cycles_log))
