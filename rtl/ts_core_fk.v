@@ -512,13 +512,9 @@ module ts_core_fk #(
 
       // joint quaternion and d streams (issued from the start on, received whatever the state)
       if (pre_valid) pre_in <= pre_in + 1'b1;
-      if (jq_valid) begin
-        jq_cnt <= jq_cnt + 1'b1;
-      end
-      if (d_valid) begin
-        d_cnt <= d_cnt + 1'b1;
-      end
-      // flags of the shared units (each result is used, so each flag counts)
+      if (jq_valid) jq_cnt <= jq_cnt + 1'b1;
+      if (d_valid) d_cnt <= d_cnt + 1'b1;
+      // the Status bits raised this cycle (fl_set); cleared at the start below
       out_flags <= out_flags | fl_set;
       // pF of the current step, whatever the state
       if (add_valid) begin
