@@ -5,15 +5,16 @@ origin and every Jacobian column, and the Status bits (out_flags = the model's f
 PUMA 560, UR5, Panda, the Stanford arm (prismatic joint), PUMA 560 with a rotated and offset base
 and tool, and the first 8 joints of chain20 (NMAX joints, one prismatic), at fresh random joint
 values within the limits (seed printed; replay with TS_SEED=<seed>; TS_NQ = vectors per chain).
-Two more chains saturate, so that the flags and the saturated values are checked too: the model
-builds them without the core's configuration checks (Model(..., checked=False)), which refuse
-them: PUMA 560 with offsets (3.5, -3.5, 3.5) m and scale 3 (compact: 1.5; positions, lever arms
-and Jacobian entries saturate; in the default configuration without its origin rotations, so that
-at q = 0 the offsets add up to 21 m, beyond pos_t's 16 m) and the Stanford arm with a prismatic scale of 3.9 driven to |q| < 7.5 (d = s q
-saturates), both at joint values anywhere in the angle format (the first vector at 0.95 of the
-range on every joint; PUMA's second at zero); and the Stanford arm's first three joints with long
-offsets along z and the same prismatic scale, whose first vector saturates only the prismatic
-origin p_3 = pF + d z (`first_rows`).
+Three more chains saturate, so that the flags and the saturated values are checked too. The model
+builds them without the core's configuration checks, which refuse them (Model(..., checked=False)),
+and their joint values are anywhere in (-7.5, 7.5) after fixed first vectors (`first_rows`) that
+saturate whatever the seed:
+- puma560_reach: PUMA 560 with offsets (3.5, -3.5, 3.5) m and scale 3 (compact 1.5); in the
+  default configuration without its origin rotations, so that at q = 0 the offsets add up to 21 m,
+  beyond pos_t's 16 m. Positions, lever arms and Jacobian entries saturate;
+- stanford_stroke: the Stanford arm with a prismatic scale of 3.9 (d = s q saturates);
+- stanford_pp: the Stanford arm's first three joints with long offsets along z and the same
+  prismatic scale, whose first vector saturates only the prismatic origin p_3 = pF + d z.
 Also: no output is X after reset, busy/done protocol, the cycle count of each evaluation (logged;
 constant for a chain), and that the width localparams of the module equal the model's formats.
 """
@@ -59,7 +60,7 @@ def chain_spec(name: str, cfg: str = "default") -> dict:
     if name == "puma560_reach":
         sp = model_spec(robots.load("puma560"))
         for j in sp["joints"]:
-            # the largest revolute scale of each format (kturn_t: |s| < 4 pi / 2^(W-I) ...)
+            # revolute scales near the limit of kturn_t = s / (4 pi): |s| < pi (compact pi / 2)
             j["origin_xyz"], j["scale"] = [3.5, -3.5, 3.5], (3.0 if cfg == "default" else 1.5)
             if cfg == "default":  # the offsets add up at q = 0: 21 m > 16 m (pos_t)
                 j["origin_quat"] = [1.0, 0.0, 0.0, 0.0]
