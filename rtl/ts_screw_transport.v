@@ -207,6 +207,8 @@ module ts_screw_transport #(
       out_z_x <= z_d[Q_W-1:0];
       out_z_y <= z_d[2*Q_W-1:Q_W];
       out_z_z <= z_d[3*Q_W-1:2*Q_W];
+      out_flags <= 16'd0;
+      out_flags[ST_QUAT] <= sat_z_d;
       if (pr_d) begin
         out_w_x <= {JW_W{1'b0}};
         out_w_y <= {JW_W{1'b0}};
@@ -214,8 +216,6 @@ module ts_screw_transport #(
         out_v_x <= vp_d[JV_W-1:0];
         out_v_y <= vp_d[2*JV_W-1:JV_W];
         out_v_z <= vp_d[3*JV_W-1:2*JV_W];
-        out_flags <= 16'd0;
-        out_flags[ST_QUAT] <= sat_z_d;
         out_flags[ST_JAC] <= sat_vp_d;
       end else begin
         out_w_x <= w_d[JW_W-1:0];
@@ -224,8 +224,6 @@ module ts_screw_transport #(
         out_v_x <= vc[0];
         out_v_y <= vc[1];
         out_v_z <= vc[2];
-        out_flags <= 16'd0;
-        out_flags[ST_QUAT] <= sat_z_d;
         out_flags[ST_LEVER] <= sat_r_d;
         out_flags[ST_JAC] <= sat_w_d | (|sat_vc);
       end
