@@ -4,12 +4,18 @@
 // derive_kturn of chain.hpp): same accept/reject decision, same first failing check (ConfigError
 // code, CFG_PARAM = 10) and joint, same turn constants k = cvt<kturn_t>(s * inv4pi).
 //
-// in_start (the CTRL.COMMIT pulse) copies the register block's outputs (rtl/ts_servo_regs.v, ports
-// in_* named after its out_* ports) into shadow registers, then runs the model's checks in the
-// model's order; the first failure ends the commit.  A start while busy restarts the commit with
-// the words present at that clock edge.  The shadow configuration (out_* after the status ports)
-// changes at the start edge: engines must use it only while out_cfg_ok = 1 (the core sequencer
-// holds a COMMIT until no tick is running).
+// in_start (the CTRL.COMMIT pulse) copies the register block's global words and the joints' JCFG
+// bits (rtl/ts_servo_regs.v, ports in_* named after its out_* ports) into shadow registers, then
+// runs the model's checks in the model's order; the first failure ends the commit.  A start while
+// busy restarts the commit with the words present at that clock edge.  The shadow configuration
+// (out_* after the status ports) changes at the start edge: engines must use it only while
+// out_cfg_ok = 1 (the core sequencer holds a COMMIT until no tick is running).
+// The joints' other words (origin, axis, scale, limits, VMAX, MU: 15 per joint) have no shadow:
+// the checks and the loader's port read in_joint_* directly, so these inputs must not change from
+// the start edge until the loader has read them (the core holds the register block's joint writes
+// from the start until its loader is done: in_joint_hold of ts_servo_regs).  A shadow would hold
+// 15 NMAX words (2,160 flip-flops in compact, 3,248 in default at NMAX 8) that the register block
+// already holds.
 //
 // Arithmetic: one shared signed multiplier (ts_mul, MA_W x MB_W: 18 x 18 in compact, 27 x 32 in
 // default), fed one product per cycle:
@@ -157,27 +163,12 @@ module ts_core_commit #(
   output wire [NMAX-1:0]             out_joint_jcfg_prismatic,
   output wire [NMAX-1:0]             out_joint_jcfg_limited,
   output wire [NMAX-1:0]             out_joint_jcfg_vlimited,
-  output wire [NMAX*QUAT_W-1:0]      out_joint_origin_qw,
-  output wire [NMAX*QUAT_W-1:0]      out_joint_origin_qx,
-  output wire [NMAX*QUAT_W-1:0]      out_joint_origin_qy,
-  output wire [NMAX*QUAT_W-1:0]      out_joint_origin_qz,
-  output wire [NMAX*LEN_W-1:0]       out_joint_origin_px,
-  output wire [NMAX*LEN_W-1:0]       out_joint_origin_py,
-  output wire [NMAX*LEN_W-1:0]       out_joint_origin_pz,
-  output wire [NMAX*QUAT_W-1:0]      out_joint_axis_x,
-  output wire [NMAX*QUAT_W-1:0]      out_joint_axis_y,
-  output wire [NMAX*QUAT_W-1:0]      out_joint_axis_z,
-  output wire [NMAX*SCALE_W-1:0]     out_joint_scale,
-  output wire [NMAX*ANGLE_W-1:0]     out_joint_lower,
-  output wire [NMAX*ANGLE_W-1:0]     out_joint_upper,
-  // velocity limit as the model holds it: VMAX when JCFG.VLIMITED, else max(qd_t)
-  output wire [NMAX*QD_W-1:0]        out_joint_vmax,
-  output wire [NMAX*MU_W-1:0]        out_joint_mu,
   // k = cvt<kturn_t>(s inv4pi) per joint (0 for prismatic joints)
   output wire [NMAX*KT_W-1:0]        out_joint_kturn,
   // The loader's port: while idle (out_busy = 0) the checks' joint multiplexers select joint
-  // in_ld_j of the shadow, and out_ld_* show its words (the core's loader reads the shadow through
-  // them instead of a second set of multiplexers); during a commit they follow the checks.
+  // in_ld_j of in_joint_* (VMAX as the model holds it, with the shadow's JCFG.VLIMITED), and
+  // out_ld_* show its words (the core's loader reads them through these instead of a second set of
+  // multiplexers); during a commit they follow the checks.
   input  wire [7:0]                  in_ld_j,
   output wire [QUAT_W-1:0]           out_ld_qo0,
   output wire [QUAT_W-1:0]           out_ld_qo1,
@@ -267,12 +258,6 @@ module ts_core_commit #(
   reg [QUAT_W-1:0]        sh_bq0, sh_bq1, sh_bq2, sh_bq3, sh_tq0, sh_tq1, sh_tq2, sh_tq3;
   reg [LEN_W-1:0]         sh_bpx, sh_bpy, sh_bpz, sh_tpx, sh_tpy, sh_tpz;
   reg [NMAX-1:0]          sh_pris, sh_lim, sh_vlim;
-  reg [NMAX*QUAT_W-1:0]   sh_qo0, sh_qo1, sh_qo2, sh_qo3, sh_ax0, sh_ax1, sh_ax2;
-  reg [NMAX*LEN_W-1:0]    sh_pox, sh_poy, sh_poz;
-  reg [NMAX*SCALE_W-1:0]  sh_s;
-  reg [NMAX*ANGLE_W-1:0]  sh_lo, sh_hi;
-  reg [NMAX*QD_W-1:0]     sh_vmax;
-  reg [NMAX*MU_W-1:0]     sh_mu;
   reg [NMAX*KT_W-1:0]     sh_kt;
 
   assign out_njoints = sh_n;
@@ -302,28 +287,7 @@ module ts_core_commit #(
   assign out_joint_jcfg_prismatic = sh_pris;
   assign out_joint_jcfg_limited = sh_lim;
   assign out_joint_jcfg_vlimited = sh_vlim;
-  assign out_joint_origin_qw = sh_qo0;
-  assign out_joint_origin_qx = sh_qo1;
-  assign out_joint_origin_qy = sh_qo2;
-  assign out_joint_origin_qz = sh_qo3;
-  assign out_joint_origin_px = sh_pox;
-  assign out_joint_origin_py = sh_poy;
-  assign out_joint_origin_pz = sh_poz;
-  assign out_joint_axis_x = sh_ax0;
-  assign out_joint_axis_y = sh_ax1;
-  assign out_joint_axis_z = sh_ax2;
-  assign out_joint_scale = sh_s;
-  assign out_joint_lower = sh_lo;
-  assign out_joint_upper = sh_hi;
-  assign out_joint_mu = sh_mu;
   assign out_joint_kturn = sh_kt;
-
-  genvar gj;
-  generate
-    for (gj = 0; gj < NMAX; gj = gj + 1) begin : g_vmax
-      assign out_joint_vmax[gj*QD_W +: QD_W] = sh_vlim[gj] ? sh_vmax[gj*QD_W +: QD_W] : QDMAX_C;
-    end
-  endgenerate
 
   // ---- helpers ------------------------------------------------------------------------------------
   // L1 norm of a len_t vector (raw, exact)
@@ -398,13 +362,13 @@ module ts_core_commit #(
   wire [JI_W-1:0] c_jm;
   wire unused_ld_j = ^in_ld_j;
   wire [QUAT_W-1:0] i_qo0, i_qo1, i_qo2, i_qo3, i_ax0, i_ax1, i_ax2;
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq0 (.in_vec(sh_qo0), .in_idx(iss_jm), .out_el(i_qo0));
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq1 (.in_vec(sh_qo1), .in_idx(iss_jm), .out_el(i_qo1));
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq2 (.in_vec(sh_qo2), .in_idx(iss_jm), .out_el(i_qo2));
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq3 (.in_vec(sh_qo3), .in_idx(iss_jm), .out_el(i_qo3));
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_ia0 (.in_vec(sh_ax0), .in_idx(iss_jm), .out_el(i_ax0));
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_ia1 (.in_vec(sh_ax1), .in_idx(iss_jm), .out_el(i_ax1));
-  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_ia2 (.in_vec(sh_ax2), .in_idx(iss_jm), .out_el(i_ax2));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq0 (.in_vec(in_joint_origin_qw), .in_idx(iss_jm), .out_el(i_qo0));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq1 (.in_vec(in_joint_origin_qx), .in_idx(iss_jm), .out_el(i_qo1));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq2 (.in_vec(in_joint_origin_qy), .in_idx(iss_jm), .out_el(i_qo2));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_iq3 (.in_vec(in_joint_origin_qz), .in_idx(iss_jm), .out_el(i_qo3));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_ia0 (.in_vec(in_joint_axis_x), .in_idx(iss_jm), .out_el(i_ax0));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_ia1 (.in_vec(in_joint_axis_y), .in_idx(iss_jm), .out_el(i_ax1));
+  ts_sel #(.W(QUAT_W), .N(NMAX), .IW(JI_W)) u_sel_ia2 (.in_vec(in_joint_axis_z), .in_idx(iss_jm), .out_el(i_ax2));
   reg [QUAT_W-1:0] q_sel;
   always @* begin
     q_sel = sh_bq0;
@@ -433,9 +397,9 @@ module ts_core_commit #(
   end
   wire [SCALE_W-1:0] s_iss;
   wire [ANGLE_W-1:0] i_lo, i_hi;
-  ts_sel #(.W(SCALE_W), .N(NMAX), .IW(JI_W)) u_sel_is (.in_vec(sh_s), .in_idx(iss_jm), .out_el(s_iss));
-  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_ilo (.in_vec(sh_lo), .in_idx(iss_jm), .out_el(i_lo));
-  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_ihi (.in_vec(sh_hi), .in_idx(iss_jm), .out_el(i_hi));
+  ts_sel #(.W(SCALE_W), .N(NMAX), .IW(JI_W)) u_sel_is (.in_vec(in_joint_scale), .in_idx(iss_jm), .out_el(s_iss));
+  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_ilo (.in_vec(in_joint_lower), .in_idx(iss_jm), .out_el(i_lo));
+  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_ihi (.in_vec(in_joint_upper), .in_idx(iss_jm), .out_el(i_hi));
   wire [ANGLE_W-1:0] lim_iss = (iss_k == 4'd8) ? i_lo : i_hi;
   // joint c_j's words as the consume stage takes them
   wire [SCALE_W-1:0] cj_s;
@@ -443,14 +407,14 @@ module ts_core_commit #(
   wire [QD_W-1:0] cj_vmax;
   wire [MU_W-1:0] cj_mu;
   wire [LEN_W-1:0] cj_pox, cj_poy, cj_poz;
-  ts_sel #(.W(SCALE_W), .N(NMAX), .IW(JI_W)) u_sel_cs (.in_vec(sh_s), .in_idx(c_jm), .out_el(cj_s));
-  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_clo (.in_vec(sh_lo), .in_idx(c_jm), .out_el(cj_lo));
-  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_chi (.in_vec(sh_hi), .in_idx(c_jm), .out_el(cj_hi));
-  ts_sel #(.W(QD_W), .N(NMAX), .IW(JI_W)) u_sel_cvm (.in_vec(sh_vmax), .in_idx(c_jm), .out_el(cj_vmax));
-  ts_sel #(.W(MU_W), .N(NMAX), .IW(JI_W)) u_sel_cmu (.in_vec(sh_mu), .in_idx(c_jm), .out_el(cj_mu));
-  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_cpx (.in_vec(sh_pox), .in_idx(c_jm), .out_el(cj_pox));
-  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_cpy (.in_vec(sh_poy), .in_idx(c_jm), .out_el(cj_poy));
-  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_cpz (.in_vec(sh_poz), .in_idx(c_jm), .out_el(cj_poz));
+  ts_sel #(.W(SCALE_W), .N(NMAX), .IW(JI_W)) u_sel_cs (.in_vec(in_joint_scale), .in_idx(c_jm), .out_el(cj_s));
+  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_clo (.in_vec(in_joint_lower), .in_idx(c_jm), .out_el(cj_lo));
+  ts_sel #(.W(ANGLE_W), .N(NMAX), .IW(JI_W)) u_sel_chi (.in_vec(in_joint_upper), .in_idx(c_jm), .out_el(cj_hi));
+  ts_sel #(.W(QD_W), .N(NMAX), .IW(JI_W)) u_sel_cvm (.in_vec(in_joint_vmax), .in_idx(c_jm), .out_el(cj_vmax));
+  ts_sel #(.W(MU_W), .N(NMAX), .IW(JI_W)) u_sel_cmu (.in_vec(in_joint_mu), .in_idx(c_jm), .out_el(cj_mu));
+  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_cpx (.in_vec(in_joint_origin_px), .in_idx(c_jm), .out_el(cj_pox));
+  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_cpy (.in_vec(in_joint_origin_py), .in_idx(c_jm), .out_el(cj_poy));
+  ts_sel #(.W(LEN_W), .N(NMAX), .IW(JI_W)) u_sel_cpz (.in_vec(in_joint_origin_pz), .in_idx(c_jm), .out_el(cj_poz));
   wire [RB-1:0] reach_op = {1'b0, reach[RB-2:0]};
 
   wire signed [MA_W-1:0] qa, sa, ma;
@@ -490,7 +454,8 @@ module ts_core_commit #(
   assign out_ld_s = cj_s;
   assign out_ld_lo = cj_lo;
   assign out_ld_hi = cj_hi;
-  assign out_ld_vmax = sh_vlim[c_jm] ? cj_vmax : QDMAX_C;   // as out_joint_vmax
+  // velocity limit as the model holds it: VMAX when JCFG.VLIMITED, else max(qd_t)
+  assign out_ld_vmax = sh_vlim[c_jm] ? cj_vmax : QDMAX_C;
   assign out_ld_mu = cj_mu;
 
   // ---- consume-side arithmetic --------------------------------------------------------------------
@@ -624,21 +589,6 @@ module ts_core_commit #(
       sh_pris <= {NMAX{1'b0}};
       sh_lim <= {NMAX{1'b0}};
       sh_vlim <= {NMAX{1'b0}};
-      sh_qo0 <= {(NMAX*QUAT_W){1'b0}};
-      sh_qo1 <= {(NMAX*QUAT_W){1'b0}};
-      sh_qo2 <= {(NMAX*QUAT_W){1'b0}};
-      sh_qo3 <= {(NMAX*QUAT_W){1'b0}};
-      sh_ax0 <= {(NMAX*QUAT_W){1'b0}};
-      sh_ax1 <= {(NMAX*QUAT_W){1'b0}};
-      sh_ax2 <= {(NMAX*QUAT_W){1'b0}};
-      sh_pox <= {(NMAX*LEN_W){1'b0}};
-      sh_poy <= {(NMAX*LEN_W){1'b0}};
-      sh_poz <= {(NMAX*LEN_W){1'b0}};
-      sh_s <= {(NMAX*SCALE_W){1'b0}};
-      sh_lo <= {(NMAX*ANGLE_W){1'b0}};
-      sh_hi <= {(NMAX*ANGLE_W){1'b0}};
-      sh_vmax <= {(NMAX*QD_W){1'b0}};
-      sh_mu <= {(NMAX*MU_W){1'b0}};
       sh_kt <= {(NMAX*KT_W){1'b0}};
       iss_act <= 1'b0;
       iss_ph <= PH_G;
@@ -718,21 +668,6 @@ module ts_core_commit #(
         sh_pris <= in_joint_jcfg_prismatic;
         sh_lim <= in_joint_jcfg_limited;
         sh_vlim <= in_joint_jcfg_vlimited;
-        sh_qo0 <= in_joint_origin_qw;
-        sh_qo1 <= in_joint_origin_qx;
-        sh_qo2 <= in_joint_origin_qy;
-        sh_qo3 <= in_joint_origin_qz;
-        sh_pox <= in_joint_origin_px;
-        sh_poy <= in_joint_origin_py;
-        sh_poz <= in_joint_origin_pz;
-        sh_ax0 <= in_joint_axis_x;
-        sh_ax1 <= in_joint_axis_y;
-        sh_ax2 <= in_joint_axis_z;
-        sh_s <= in_joint_scale;
-        sh_lo <= in_joint_lower;
-        sh_hi <= in_joint_upper;
-        sh_vmax <= in_joint_vmax;
-        sh_mu <= in_joint_mu;
         sh_kt <= {(NMAX*KT_W){1'b0}};
         state <= S_COUNT;
         iss_act <= 1'b0;

@@ -12,7 +12,8 @@
 // Sequencer: IDLE -> IN -> PREP (q and warm start into the engines) -> FK -> LAW (columns through
 // the law's basis port into the solver) -> V -> SOLVE -> OUT.  CTRL.COMMIT is held while a tick
 // runs; after a successful commit a loader (LOAD) writes the engines' configuration ports from
-// the commit's shadow outputs.  Ticks run only while CFG_OK and CTRL.RUN (TREADY low otherwise).
+// the commit's shadow outputs and the register block's joint words (whose writes wait from the
+// commit's start until LOAD ends).  Ticks run only while CFG_OK and CTRL.RUN (TREADY low otherwise).
 `resetall
 `timescale 1ns / 1ps
 `default_nettype none
@@ -102,6 +103,7 @@ module ts_servo_core #(
   reg  [31:0] tick_count, tick_cycles;
   wire st_busy, cfg_ok, cfg_err, cfg_busy;
   wire [7:0] err_code, err_joint;
+  wire joint_hold;                // the register block's joint writes wait (commit and load)
 
   wire [7:0] r_njoints, r_sweeps;
   wire r_err_b, r_err_only;
@@ -134,7 +136,7 @@ module ts_servo_core #(
     .in_status_busy(st_busy), .in_status_cfg_ok(cfg_ok), .in_status_cfg_err(cfg_err),
     .in_status_cfg_busy(cfg_busy), .in_cfg_error_code(err_code), .in_cfg_error_joint(err_joint),
     .in_flags_set(flags_set), .out_flags(flags_q), .in_tick_count(tick_count),
-    .in_tick_cycles(tick_cycles),
+    .in_tick_cycles(tick_cycles), .in_joint_hold(joint_hold),
     .out_njoints(r_njoints), .out_mode_err_b(r_err_b), .out_mode_error_only(r_err_only),
     .out_mode_sweeps(r_sweeps), .out_mode_warm_leak(r_leak), .out_kp(r_kp), .out_ko(r_ko),
     .out_lchar(r_lchar), .out_klim(r_klim), .out_dt(r_dt),
@@ -163,15 +165,9 @@ module ts_servo_core #(
   wire signed [QUAT_W-1:0] c_bqw, c_bqx, c_bqy, c_bqz, c_tqw, c_tqx, c_tqy, c_tqz;
   wire signed [LEN_W-1:0] c_bpx, c_bpy, c_bpz, c_tpx, c_tpy, c_tpz;
   wire [NMAX-1:0] c_pri, c_lim, c_vlim;
-  wire [NMAX*QUAT_W-1:0] c_oqw, c_oqx, c_oqy, c_oqz, c_ax, c_ay, c_az;
-  wire [NMAX*LEN_W-1:0] c_opx, c_opy, c_opz;
-  wire [NMAX*SCALE_W-1:0] c_scale;
-  wire [NMAX*ANGLE_W-1:0] c_lower, c_upper;
-  wire [NMAX*QD_W-1:0] c_vmax;
-  wire [NMAX*MU_W-1:0] c_mu;
   wire [NMAX*KT_W-1:0] c_kturn;
 
-  // the loader's joint and that joint's shadow words, through the commit engine's multiplexers
+  // the loader's joint and that joint's register words, through the commit engine's multiplexers
   wire [7:0] ld_j8;
   wire [QUAT_W-1:0] j_oqw, j_oqx, j_oqy, j_oqz, j_ax, j_ay, j_az;
   wire [LEN_W-1:0] j_opx, j_opy, j_opz;
@@ -204,19 +200,12 @@ module ts_servo_core #(
     .out_tool_qw(c_tqw), .out_tool_qx(c_tqx), .out_tool_qy(c_tqy), .out_tool_qz(c_tqz),
     .out_tool_px(c_tpx), .out_tool_py(c_tpy), .out_tool_pz(c_tpz),
     .out_joint_jcfg_prismatic(c_pri), .out_joint_jcfg_limited(c_lim), .out_joint_jcfg_vlimited(c_vlim),
-    .out_joint_origin_qw(c_oqw), .out_joint_origin_qx(c_oqx), .out_joint_origin_qy(c_oqy),
-    .out_joint_origin_qz(c_oqz), .out_joint_origin_px(c_opx), .out_joint_origin_py(c_opy),
-    .out_joint_origin_pz(c_opz), .out_joint_axis_x(c_ax), .out_joint_axis_y(c_ay), .out_joint_axis_z(c_az),
-    .out_joint_scale(c_scale), .out_joint_lower(c_lower), .out_joint_upper(c_upper),
-    .out_joint_vmax(c_vmax), .out_joint_mu(c_mu), .out_joint_kturn(c_kturn),
+    .out_joint_kturn(c_kturn),
     .in_ld_j(ld_j8), .out_ld_qo0(j_oqw), .out_ld_qo1(j_oqx), .out_ld_qo2(j_oqy), .out_ld_qo3(j_oqz),
     .out_ld_ax0(j_ax), .out_ld_ax1(j_ay), .out_ld_ax2(j_az), .out_ld_pox(j_opx), .out_ld_poy(j_opy),
     .out_ld_poz(j_opz), .out_ld_s(j_sc), .out_ld_lo(j_lo), .out_ld_hi(j_hi), .out_ld_vmax(j_vm),
     .out_ld_mu(j_mu)
   );
-  // The shadow's joint buses: the loader reads them through out_ld_* (kturn excepted)
-  wire unused_shadow = ^{c_oqw, c_oqx, c_oqy, c_oqz, c_ax, c_ay, c_az, c_opx, c_opy, c_opz, c_scale,
-                         c_lower, c_upper, c_vmax, c_mu};
 
   // ---- sequencer state ---------------------------------------------------------------------------
   reg [3:0] st;
@@ -270,6 +259,11 @@ module ts_servo_core #(
   assign cfg_busy = pend || (st == S_CMT) || (st == S_LOAD);
   assign cfg_ok = c_ok && loaded;
   assign cfg_err = c_err;
+  // The commit engine keeps no shadow of the joints' words (it would duplicate the register block's
+  // 15 NMAX words): its checks and the loader read the register block directly, so joint-register
+  // writes wait from the start edge (st = S_CMT) until the loader is done.  The AXI write is
+  // accepted and its response delayed; global registers (CTRL, FLAGS, MODE, ...) are not held.
+  assign joint_hold = (st == S_CMT) || (st == S_LOAD);
 
   // ---- loader: configuration words of the engines --------------------------------------------------
   wire ld_g = ld[LA_W-1];

@@ -8,7 +8,9 @@
 // Write: the AW and W beats are captured independently (in either order or together; each
 // channel holds one beat, its READY is low while it holds one); the write is performed at the
 // first clock edge at which both are held and the B channel is free, and BVALID rises at that
-// edge: register outputs change and strobe pulses (one cycle) start at the same edge.
+// edge: register outputs change and strobe pulses (one cycle) start at the same edge.  While
+// in_joint_hold is high a write to a joint block (word 64 and above) waits, its beats held and
+// BVALID low, and is performed at the first such edge after in_joint_hold falls.
 // Read: ARREADY is high while no read is pending; the data are sampled one cycle after the AR
 // handshake (core inputs of ro registers at that edge) and RVALID is held until RREADY.
 // Errors (SLVERR): unmapped words, joint blocks j >= NMAX, writes to registers without a writable
@@ -73,6 +75,8 @@ module ts_servo_regs #(
   input  wire                 s_axil_rready,
 
   // Core side
+  // while high, writes to joint blocks wait (both beats held, BVALID delayed); others do not
+  input  wire                 in_joint_hold,
   // CTRL.RUN: rw
   output wire                 out_ctrl_run,
   // CTRL.COMMIT: one-cycle pulse
@@ -288,8 +292,10 @@ module ts_servo_regs #(
   reg         b_valid;
   reg  [1:0]  b_resp;
   wire        wr_ok;
-  // The write happens in this cycle: both beats held, the B channel free.
-  wire        wr_go = aw_full && w_full && (!b_valid || s_axil_bready);
+  // Words 64.. (joint blocks and the unmapped words above them) wait while in_joint_hold
+  wire        wr_wait = in_joint_hold && (aw_word[9:6] != 4'd0);
+  // The write happens in this cycle: both beats held, the B channel free, not held.
+  wire        wr_go = aw_full && w_full && (!b_valid || s_axil_bready) && !wr_wait;
   wire [31:0] wr_mask = {{8{w_strb[3]}}, {8{w_strb[2]}}, {8{w_strb[1]}}, {8{w_strb[0]}}};
   // Bits written 1 (strobed)
   wire [31:0] wr_ones = w_data & wr_mask;

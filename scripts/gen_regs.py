@@ -360,7 +360,8 @@ class VerilogEmitter:
     # port list ------------------------------------------------------------------------------------
     def ports(self) -> list[tuple[str, str, str, str]]:
         """(direction, range, name, comment) of the core-side ports."""
-        out = []
+        out = [("input", "", "in_joint_hold",
+                "while high, writes to joint blocks wait (both beats held, BVALID delayed); others do not")]
         for r in self.glob + self.joint:
             sticky = [f for f in r.fields if f.kind == "sticky"]
             for f in r.fields:
@@ -403,7 +404,9 @@ class VerilogEmitter:
         w("// Write: the AW and W beats are captured independently (in either order or together; each")
         w("// channel holds one beat, its READY is low while it holds one); the write is performed at the")
         w("// first clock edge at which both are held and the B channel is free, and BVALID rises at that")
-        w("// edge: register outputs change and strobe pulses (one cycle) start at the same edge.")
+        w("// edge: register outputs change and strobe pulses (one cycle) start at the same edge.  While")
+        w("// in_joint_hold is high a write to a joint block (word 64 and above) waits, its beats held and")
+        w("// BVALID low, and is performed at the first such edge after in_joint_hold falls.")
         w("// Read: ARREADY is high while no read is pending; the data are sampled one cycle after the AR")
         w("// handshake (core inputs of ro registers at that edge) and RVALID is held until RREADY.")
         w("// Errors (SLVERR): unmapped words, joint blocks j >= NMAX, writes to registers without a writable")
@@ -521,8 +524,10 @@ class VerilogEmitter:
         w("  reg         b_valid;")
         w("  reg  [1:0]  b_resp;")
         w("  wire        wr_ok;")
-        w("  // The write happens in this cycle: both beats held, the B channel free.")
-        w("  wire        wr_go = aw_full && w_full && (!b_valid || s_axil_bready);")
+        w("  // Words 64.. (joint blocks and the unmapped words above them) wait while in_joint_hold")
+        w("  wire        wr_wait = in_joint_hold && (aw_word[9:6] != 4'd0);")
+        w("  // The write happens in this cycle: both beats held, the B channel free, not held.")
+        w("  wire        wr_go = aw_full && w_full && (!b_valid || s_axil_bready) && !wr_wait;")
         w("  wire [31:0] wr_mask = {{8{w_strb[3]}}, {8{w_strb[2]}}, {8{w_strb[1]}}, {8{w_strb[0]}}};")
         w("  // Bits written 1 (strobed)")
         w("  wire [31:0] wr_ones = w_data & wr_mask;")

@@ -15,6 +15,7 @@ Tests (every one starts from reset; fresh seed per run, TS_SEED replays):
 - cycles per tick (TICK_CYCLES) of PUMA 560 at 10 and 2 sweeps, without gaps (logged and
   written to TS_CYCLES_FILE);
 - CTRL.COMMIT during a tick;
+- a joint-register write during a commit (it waits until the loader is done);
 - FLAGS against the OR of the packets' status flags (set by a far setpoint, cleared by writing 1
   and by CTRL.CLEAR), and CTRL.VIRTUAL switched between ticks with the packet's q off the core's.
 """
@@ -389,6 +390,55 @@ if os.environ.get("COCOTB_SIM") or os.environ.get("TOPLEVEL"):
         lp.warm = [0] * lp.n
         lp.q_int = [0] * lp.n
         await closed_loop(tb, lp, 3, load_at=())
+        assert not tb.errors, f"{len(tb.errors)} mismatches, first: {tb.errors[0]}"
+
+    @cocotb.test()
+    async def joint_write_during_commit(dut):
+        """A joint-register write issued while a commit runs waits until the loader is done (the
+        commit engine reads the register block's joint words directly, without a shadow): the
+        commit succeeds with the words of its start and the ticks match the model's committed
+        state; the register then reads the new word, and the next commit refuses it."""
+        tb = await setup(dut)
+        tb.gaps(False)
+        raw = raw_from_chain(robots.load("puma560"), tb.cfg, sweeps=2)
+        lp = await bring_up(tb, "puma560", sweeps=2)
+        await closed_loop(tb, lp, 1)
+        # joint 0's axis no longer a unit vector: the commit would refuse it (code 2, joint 0)
+        bad = json.loads(json.dumps(raw))
+        bad["joints"][0]["axis"][0] += 1 << (fw(tb.cfg, "quat_t")[1] - 4)
+        res_bad, _ = _model.commit_raw(tb.cfg, bad, NMAX)
+        assert (res_bad["code"], res_bad["joint"]) == (2, 0), res_bad
+        addr = regs.joint_addr(0, "AXIS_X")
+        word = bad["joints"][0]["axis"][0] & 0xFFFFFFFF
+        await tb.wr(regs.CTRL, regs.CTRL_RUN | regs.CTRL_COMMIT)
+        ev = tb.axil.init_write(addr, word.to_bytes(4, "little"))
+        busy_while_pending = 0
+        for _ in range(10000):
+            st = await tb.rd(regs.STATUS)
+            if ev.is_set():
+                break
+            busy_while_pending += bool(st & regs.STATUS_CFG_BUSY)
+        else:
+            raise AssertionError("the joint write never completed")
+        assert int(ev.data.resp) == regs.RESP_OKAY
+        st_answer = await tb.rd(regs.STATUS)
+        st = st_answer
+        while st & regs.STATUS_CFG_BUSY:
+            st = await tb.rd(regs.STATUS)
+        assert await tb.rd(addr) == word
+        # the commit zeroes the warm start and the virtual q; its state is the old words'
+        lp.warm = [0] * lp.n
+        lp.q_int = [0] * lp.n
+        tb.ticks = await tb.rd(regs.TICK_COUNT)
+        if st & regs.STATUS_CFG_OK:
+            await closed_loop(tb, lp, 2, load_at=())
+        assert not tb.errors, f"ticks after the commit: {len(tb.errors)} mismatches, first: {tb.errors[0]}"
+        assert st & regs.STATUS_CFG_OK, f"STATUS {st:#x} after the commit (CFG_OK expected)"
+        assert not st_answer & regs.STATUS_CFG_BUSY, f"the joint write was answered during the commit ({st_answer:#x})"
+        assert busy_while_pending, "the joint write did not meet the commit (CFG_BUSY never seen)"
+        dut._log.info("joint write waited over %d STATUS reads with CFG_BUSY", busy_while_pending)
+        st, code, joint = await tb.commit(regs.CTRL_RUN)
+        assert (code, joint) == (2, 0) and st & regs.STATUS_CFG_ERR, (hex(st), code, joint)
         assert not tb.errors, f"{len(tb.errors)} mismatches, first: {tb.errors[0]}"
 
     #: the FLAGS register's bits (the model's status bits 0-9, 16, 17)

@@ -71,9 +71,10 @@ if cocotb is not None:
                     getattr(dut, "s_axil_" + s).value = 0
             self.drive_inputs({})
             dut.in_flags_set.value = 0
+            dut.in_joint_hold.value = 0
 
         def model_ports(self) -> list[str]:
-            return list(self.model.outputs()) + ["in_flags_set"] + [
+            return list(self.model.outputs()) + ["in_flags_set", "in_joint_hold"] + [
                 "in_" + port_base(r, f, False) for r in regs.GLOBAL.values() for f in r.fields if f.access == "ro"]
 
         # ---- set-up ------------------------------------------------------------------------------
@@ -502,6 +503,40 @@ if cocotb is not None:
         await tb.check_all("after writes to unmapped words")
         dut._log.info("%d mapped words, %d unmapped written", len(mapped), n_err)
         assert n_err == 1024 - len(mapped)
+        tb.check_monitor()
+
+    @cocotb.test(timeout_time=TIMEOUT_US, timeout_unit="us")
+    async def joint_hold(dut):
+        """in_joint_hold (the core raises it while its commit and loader read the joint registers):
+        a write to a joint block waits, BVALID low and every out_ port unchanged, for as long as it
+        is high, and completes right after it falls; global writes (CTRL included) are not held."""
+        tb = await setup(dut, master=False)
+        rw = tb.model.rw_addrs()
+        jaddrs = [a for a in rw if a >= regs.JOINT_BASE]
+        gaddrs = [a for a in rw if a < regs.JOINT_BASE]
+        assert jaddrs and regs.CTRL in gaddrs
+        for rep in range(12):
+            dut.in_joint_hold.value = 1
+            g = regs.CTRL if rep == 0 else tb.rng.choice(gaddrs)
+            data = tb.rng.getrandbits(32)
+            resp, _ = await tb.raw_write(g, data, 0xF, tb.rng.randrange(3), tb.rng.randrange(3))
+            tb.expect_write(g, data, 0xF, resp)
+            tb.check_outputs(f"global write 0x{g:03X} while held")
+            a = tb.rng.choice(jaddrs)
+            data = tb.rng.getrandbits(32)
+            wr = cocotb.start_soon(tb.raw_write(a, data, 0xF, tb.rng.randrange(3), tb.rng.randrange(3)))
+            for _ in range(tb.rng.randrange(4, 24)):
+                await FallingEdge(dut.clk)
+                assert not int(dut.s_axil_bvalid.value), f"write 0x{a:03X} answered while held"
+                tb.check_outputs(f"joint write 0x{a:03X} held")
+            released = tb.cycle
+            dut.in_joint_hold.value = 0
+            resp, first = await wr
+            assert first <= released + 1, f"write 0x{a:03X}: B {first - released} cycles after the release"
+            tb.expect_write(a, data, 0xF, resp)
+            tb.check_outputs(f"joint write 0x{a:03X} released")
+            rdata, rresp = await tb.raw_read(a)
+            tb.expect_read(a, rdata, rresp)
         tb.check_monitor()
 
     @cocotb.test(timeout_time=TIMEOUT_US, timeout_unit="us")
