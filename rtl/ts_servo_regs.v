@@ -376,9 +376,10 @@ module ts_servo_regs #(
 
   // ---- read channel -------------------------------------------------------------------
   // A read takes two cycles: the accepted address (ar_full), then the words selected by it
-  // registered (rd_full: the joint's stored fields and the global word), then the response.
-  // The joint multiplexer reaches every joint's registers across the device; with the field
-  // select and the response in the same cycle it was the whole core's critical path.
+  // registered (rd_full: the joint word from the block-RAM mirror and the global word), then
+  // the response.  The joint word was a multiplexer over every joint's registers across the
+  // device; with the field select and the response in the same cycle it was the whole core's
+  // critical path, hence the registered stage (now the RAM's read register).
   reg         ar_full;
   reg  [9:0]  ar_word;
   reg  [5:0]  ar_jidx;        // joint index of the accepted address (block - 4)
@@ -746,27 +747,6 @@ module ts_servo_regs #(
   wire [31:0] rd_tool_pz = sx_tool_pz_q;
 
   // ---- joint blocks ---------------------------------------------------------------------
-  // Every joint's stored fields side by side (field offsets JO_*, JV_W bits per joint)
-  localparam integer JO_JCFG_PRISMATIC = 0;
-  localparam integer JO_JCFG_LIMITED = JO_JCFG_PRISMATIC + 1;
-  localparam integer JO_JCFG_VLIMITED = JO_JCFG_LIMITED + 1;
-  localparam integer JO_ORIGIN_QW = JO_JCFG_VLIMITED + 1;
-  localparam integer JO_ORIGIN_QX = JO_ORIGIN_QW + QUAT_W;
-  localparam integer JO_ORIGIN_QY = JO_ORIGIN_QX + QUAT_W;
-  localparam integer JO_ORIGIN_QZ = JO_ORIGIN_QY + QUAT_W;
-  localparam integer JO_ORIGIN_PX = JO_ORIGIN_QZ + QUAT_W;
-  localparam integer JO_ORIGIN_PY = JO_ORIGIN_PX + LEN_W;
-  localparam integer JO_ORIGIN_PZ = JO_ORIGIN_PY + LEN_W;
-  localparam integer JO_AXIS_X = JO_ORIGIN_PZ + LEN_W;
-  localparam integer JO_AXIS_Y = JO_AXIS_X + QUAT_W;
-  localparam integer JO_AXIS_Z = JO_AXIS_Y + QUAT_W;
-  localparam integer JO_SCALE = JO_AXIS_Z + QUAT_W;
-  localparam integer JO_LOWER = JO_SCALE + SCALE_W;
-  localparam integer JO_UPPER = JO_LOWER + ANGLE_W;
-  localparam integer JO_VMAX = JO_UPPER + ANGLE_W;
-  localparam integer JO_MU = JO_VMAX + QD_W;
-  localparam integer JV_W = JO_MU + MU_W;
-  wire [NMAX*JV_W-1:0] jnt_vec;
   // Every word of a joint block is a register.
   wire        rd_jnt_ok = 1'b1;
 
@@ -876,75 +856,124 @@ module ts_servo_regs #(
         end
       end
 
-      // Core-side outputs and the joint's stored fields for the read multiplexer
+      // Core-side outputs
       assign out_joint_jcfg_prismatic[j] = joint_jcfg_prismatic_q;
-      assign jnt_vec[j*JV_W + JO_JCFG_PRISMATIC +: 1] = joint_jcfg_prismatic_q;
       assign out_joint_jcfg_limited[j] = joint_jcfg_limited_q;
-      assign jnt_vec[j*JV_W + JO_JCFG_LIMITED +: 1] = joint_jcfg_limited_q;
       assign out_joint_jcfg_vlimited[j] = joint_jcfg_vlimited_q;
-      assign jnt_vec[j*JV_W + JO_JCFG_VLIMITED +: 1] = joint_jcfg_vlimited_q;
       assign out_joint_origin_qw[j*QUAT_W +: QUAT_W] = joint_origin_qw_q;
-      assign jnt_vec[j*JV_W + JO_ORIGIN_QW +: QUAT_W] = joint_origin_qw_q;
       assign out_joint_origin_qx[j*QUAT_W +: QUAT_W] = joint_origin_qx_q;
-      assign jnt_vec[j*JV_W + JO_ORIGIN_QX +: QUAT_W] = joint_origin_qx_q;
       assign out_joint_origin_qy[j*QUAT_W +: QUAT_W] = joint_origin_qy_q;
-      assign jnt_vec[j*JV_W + JO_ORIGIN_QY +: QUAT_W] = joint_origin_qy_q;
       assign out_joint_origin_qz[j*QUAT_W +: QUAT_W] = joint_origin_qz_q;
-      assign jnt_vec[j*JV_W + JO_ORIGIN_QZ +: QUAT_W] = joint_origin_qz_q;
       assign out_joint_origin_px[j*LEN_W +: LEN_W] = joint_origin_px_q;
-      assign jnt_vec[j*JV_W + JO_ORIGIN_PX +: LEN_W] = joint_origin_px_q;
       assign out_joint_origin_py[j*LEN_W +: LEN_W] = joint_origin_py_q;
-      assign jnt_vec[j*JV_W + JO_ORIGIN_PY +: LEN_W] = joint_origin_py_q;
       assign out_joint_origin_pz[j*LEN_W +: LEN_W] = joint_origin_pz_q;
-      assign jnt_vec[j*JV_W + JO_ORIGIN_PZ +: LEN_W] = joint_origin_pz_q;
       assign out_joint_axis_x[j*QUAT_W +: QUAT_W] = joint_axis_x_q;
-      assign jnt_vec[j*JV_W + JO_AXIS_X +: QUAT_W] = joint_axis_x_q;
       assign out_joint_axis_y[j*QUAT_W +: QUAT_W] = joint_axis_y_q;
-      assign jnt_vec[j*JV_W + JO_AXIS_Y +: QUAT_W] = joint_axis_y_q;
       assign out_joint_axis_z[j*QUAT_W +: QUAT_W] = joint_axis_z_q;
-      assign jnt_vec[j*JV_W + JO_AXIS_Z +: QUAT_W] = joint_axis_z_q;
       assign out_joint_scale[j*SCALE_W +: SCALE_W] = joint_scale_q;
-      assign jnt_vec[j*JV_W + JO_SCALE +: SCALE_W] = joint_scale_q;
       assign out_joint_lower[j*ANGLE_W +: ANGLE_W] = joint_lower_q;
-      assign jnt_vec[j*JV_W + JO_LOWER +: ANGLE_W] = joint_lower_q;
       assign out_joint_upper[j*ANGLE_W +: ANGLE_W] = joint_upper_q;
-      assign jnt_vec[j*JV_W + JO_UPPER +: ANGLE_W] = joint_upper_q;
       assign out_joint_vmax[j*QD_W +: QD_W] = joint_vmax_q;
-      assign jnt_vec[j*JV_W + JO_VMAX +: QD_W] = joint_vmax_q;
       assign out_joint_mu[j*MU_W +: MU_W] = joint_mu_q;
-      assign jnt_vec[j*JV_W + JO_MU +: MU_W] = joint_mu_q;
     end
   endgenerate
 
-  // Read word of the addressed joint: the joint's stored fields (one NMAX:1 multiplexer tree,
-  // ts_sel, registered in rj_q), then the word, then the sign extension.  Selecting the joint
-  // first on the stored bits costs about a fifth of selecting every joint's sign-extended word
-  // (ECP5 LUT4).
-  wire [JV_W-1:0] rj;
-  reg  [JV_W-1:0] rj_q;
-  ts_sel #(.W(JV_W), .N(NMAX), .IW(6)) u_rd_joint (.in_vec(jnt_vec), .in_idx(ar_jidx), .out_el(rj));
+  // ---- joint read-back: a mirror of the joint blocks in block RAM ------------------------
+  // Every write to a joint block is also written, byte by byte as strobed, into jm_ram (NMAX x
+  // 16 words; one ECP5 DP16KD up to NMAX 32), and a read of a joint word takes it from there:
+  // the registers above stay the core's copy, but are not multiplexed for the bus (the NMAX:1
+  // multiplexer over every joint's fields it replaces: 1,222 ECP5 LUT4 at NMAX 8, -nowidelut).
+  // The RAM is not reset: jm_written (a bit per word, cleared by rst) tells whether a word has
+  // been written since the reset; an unwritten word reads as its reset value, and the first
+  // write of a word fills its unstrobed bytes with the reset value's.  A read and a write of
+  // the same word at the same edge read the old word, as the registers would.
+  localparam integer JM_AW = $clog2(NMAX * 16);
+  localparam integer JM_DEPTH = 1 << JM_AW;
+  (* ram_style = "block" *) reg [31:0] jm_ram [0:JM_DEPTH-1];
+  reg  [JM_DEPTH-1:0] jm_written;
+  wire [9:0]  jm_waddr_full = {wr_jidx, aw_word[3:0]};
+  wire [9:0]  jm_raddr_full = {ar_jidx, ar_word[3:0]};
+  wire [JM_AW-1:0] jm_waddr = jm_waddr_full[JM_AW-1:0];
+  wire [JM_AW-1:0] jm_raddr = jm_raddr_full[JM_AW-1:0];
+  generate
+    if (JM_AW < 10) begin : g_jm_unused
+      wire unused_jm = ^{jm_waddr_full[9:JM_AW], jm_raddr_full[9:JM_AW]};
+    end
+  endgenerate
+
+  // Reset value of the joint word at a word offset (a read word: fields in place, sign-extended)
+  function [31:0] jm_rst;
+    input [3:0] off;
+    begin
+      case (off)
+        4'h0: jm_rst = {29'd0, RST_JOINT_JCFG_VLIMITED, RST_JOINT_JCFG_LIMITED, RST_JOINT_JCFG_PRISMATIC};
+        4'h1: jm_rst = RST_JOINT_ORIGIN_QW;
+        4'h2: jm_rst = RST_JOINT_ORIGIN_QX;
+        4'h3: jm_rst = RST_JOINT_ORIGIN_QY;
+        4'h4: jm_rst = RST_JOINT_ORIGIN_QZ;
+        4'h5: jm_rst = RST_JOINT_ORIGIN_PX;
+        4'h6: jm_rst = RST_JOINT_ORIGIN_PY;
+        4'h7: jm_rst = RST_JOINT_ORIGIN_PZ;
+        4'h8: jm_rst = RST_JOINT_AXIS_X;
+        4'h9: jm_rst = RST_JOINT_AXIS_Y;
+        4'hA: jm_rst = RST_JOINT_AXIS_Z;
+        4'hB: jm_rst = RST_JOINT_SCALE;
+        4'hC: jm_rst = RST_JOINT_LOWER;
+        4'hD: jm_rst = RST_JOINT_UPPER;
+        4'hE: jm_rst = RST_JOINT_VMAX;
+        4'hF: jm_rst = RST_JOINT_MU;
+        default: jm_rst = 32'd0;
+      endcase
+    end
+  endfunction
+
+  wire        jm_we = wr_go && wr_jnt;
+  wire        jm_first = !jm_written[jm_waddr];   // first write since the reset
+  wire [31:0] jm_wrst = jm_rst(aw_word[3:0]);
   always @(posedge clk) begin
-    if (rst) rj_q <= {JV_W{1'b0}};
-    else if (ar_full) rj_q <= rj;
+    if (jm_we) begin
+      if (w_strb[0] || jm_first) jm_ram[jm_waddr][7:0] <= w_strb[0] ? w_data[7:0] : jm_wrst[7:0];
+      if (w_strb[1] || jm_first) jm_ram[jm_waddr][15:8] <= w_strb[1] ? w_data[15:8] : jm_wrst[15:8];
+      if (w_strb[2] || jm_first) jm_ram[jm_waddr][23:16] <= w_strb[2] ? w_data[23:16] : jm_wrst[23:16];
+      if (w_strb[3] || jm_first) jm_ram[jm_waddr][31:24] <= w_strb[3] ? w_data[31:24] : jm_wrst[31:24];
+    end
   end
-  wire rj_jcfg_prismatic = rj_q[JO_JCFG_PRISMATIC +: 1];
-  wire rj_jcfg_limited = rj_q[JO_JCFG_LIMITED +: 1];
-  wire rj_jcfg_vlimited = rj_q[JO_JCFG_VLIMITED +: 1];
-  wire [QUAT_W-1:0] rj_origin_qw = rj_q[JO_ORIGIN_QW +: QUAT_W];
-  wire [QUAT_W-1:0] rj_origin_qx = rj_q[JO_ORIGIN_QX +: QUAT_W];
-  wire [QUAT_W-1:0] rj_origin_qy = rj_q[JO_ORIGIN_QY +: QUAT_W];
-  wire [QUAT_W-1:0] rj_origin_qz = rj_q[JO_ORIGIN_QZ +: QUAT_W];
-  wire [LEN_W-1:0] rj_origin_px = rj_q[JO_ORIGIN_PX +: LEN_W];
-  wire [LEN_W-1:0] rj_origin_py = rj_q[JO_ORIGIN_PY +: LEN_W];
-  wire [LEN_W-1:0] rj_origin_pz = rj_q[JO_ORIGIN_PZ +: LEN_W];
-  wire [QUAT_W-1:0] rj_axis_x = rj_q[JO_AXIS_X +: QUAT_W];
-  wire [QUAT_W-1:0] rj_axis_y = rj_q[JO_AXIS_Y +: QUAT_W];
-  wire [QUAT_W-1:0] rj_axis_z = rj_q[JO_AXIS_Z +: QUAT_W];
-  wire [SCALE_W-1:0] rj_scale = rj_q[JO_SCALE +: SCALE_W];
-  wire [ANGLE_W-1:0] rj_lower = rj_q[JO_LOWER +: ANGLE_W];
-  wire [ANGLE_W-1:0] rj_upper = rj_q[JO_UPPER +: ANGLE_W];
-  wire [QD_W-1:0] rj_vmax = rj_q[JO_VMAX +: QD_W];
-  wire [MU_W-1:0] rj_mu = rj_q[JO_MU +: MU_W];
+  always @(posedge clk) begin
+    if (rst) jm_written <= {JM_DEPTH{1'b0}};
+    else if (jm_we) jm_written[jm_waddr] <= 1'b1;
+  end
+
+  // The read's first cycle: the addressed word and its written bit, registered
+  reg  [31:0] jm_q;
+  reg         jm_q_written;
+  always @(posedge clk) begin
+    if (ar_full && rd_jnt) jm_q <= jm_ram[jm_raddr];
+  end
+  always @(posedge clk) begin
+    if (rst) jm_q_written <= 1'b0;
+    else if (ar_full) jm_q_written <= rd_jnt && jm_written[jm_raddr];
+  end
+  wire [31:0] jm_word = jm_q_written ? jm_q : jm_rst(ar_word[3:0]);
+  wire        unused_jm_word = ^jm_word;    // the bits above the narrower formats
+  // Its stored fields, as the registers hold them (the read word rebuilt from them below)
+  wire rj_jcfg_prismatic = jm_word[0 +: 1];
+  wire rj_jcfg_limited = jm_word[1 +: 1];
+  wire rj_jcfg_vlimited = jm_word[2 +: 1];
+  wire [QUAT_W-1:0] rj_origin_qw = jm_word[0 +: QUAT_W];
+  wire [QUAT_W-1:0] rj_origin_qx = jm_word[0 +: QUAT_W];
+  wire [QUAT_W-1:0] rj_origin_qy = jm_word[0 +: QUAT_W];
+  wire [QUAT_W-1:0] rj_origin_qz = jm_word[0 +: QUAT_W];
+  wire [LEN_W-1:0] rj_origin_px = jm_word[0 +: LEN_W];
+  wire [LEN_W-1:0] rj_origin_py = jm_word[0 +: LEN_W];
+  wire [LEN_W-1:0] rj_origin_pz = jm_word[0 +: LEN_W];
+  wire [QUAT_W-1:0] rj_axis_x = jm_word[0 +: QUAT_W];
+  wire [QUAT_W-1:0] rj_axis_y = jm_word[0 +: QUAT_W];
+  wire [QUAT_W-1:0] rj_axis_z = jm_word[0 +: QUAT_W];
+  wire [SCALE_W-1:0] rj_scale = jm_word[0 +: SCALE_W];
+  wire [ANGLE_W-1:0] rj_lower = jm_word[0 +: ANGLE_W];
+  wire [ANGLE_W-1:0] rj_upper = jm_word[0 +: ANGLE_W];
+  wire [QD_W-1:0] rj_vmax = jm_word[0 +: QD_W];
+  wire [MU_W-1:0] rj_mu = jm_word[0 +: MU_W];
   // Fixed-point values sign-extended to the 32-bit read word
   generate
     wire [31:0] sx_rj_origin_qw;

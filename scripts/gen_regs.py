@@ -600,9 +600,10 @@ class VerilogEmitter:
         # read channel registers and decode
         w("  // ---- read channel -------------------------------------------------------------------")
         w("  // A read takes two cycles: the accepted address (ar_full), then the words selected by it")
-        w("  // registered (rd_full: the joint's stored fields and the global word), then the response.")
-        w("  // The joint multiplexer reaches every joint's registers across the device; with the field")
-        w("  // select and the response in the same cycle it was the whole core's critical path.")
+        w("  // registered (rd_full: the joint word from the block-RAM mirror and the global word), then")
+        w("  // the response.  The joint word was a multiplexer over every joint's registers across the")
+        w("  // device; with the field select and the response in the same cycle it was the whole core's")
+        w("  // critical path, hence the registered stage (now the RAM's read register).")
         w("  reg         ar_full;")
         w("  reg  [9:0]  ar_word;")
         w("  reg  [5:0]  ar_jidx;        // joint index of the accepted address (block - 4)")
@@ -829,18 +830,29 @@ class VerilogEmitter:
             w(f"{indent[:-2]}endgenerate")
         w("")
 
+    def rst_word(self, r: Reg) -> str:
+        """Read word of register r right after the reset: its fields' reset values in place
+        (a fixed-point field's RST_ constant is already its 32-bit sign extension)."""
+        parts, pos = [], 0
+        for f in r.fields:
+            assert f.kind == "rw", f"{r.name}.{f.name}: the joint mirror holds rw fields only"
+            if f.lsb > pos:
+                parts.append(f"{f.lsb - pos}'d0")
+            if f.fmt:
+                assert f.lsb == 0 and len(r.fields) == 1, f"{r.name}: a fixed-point field fills its word"
+                return self.rst_name(r, f)
+            parts.append(self.rst_name(r, f))
+            pos = f.msb + 1
+        if pos < 32:
+            parts.append(f"{32 - pos}'d0")
+        parts.reverse()
+        return parts[0] if len(parts) == 1 else "{" + ", ".join(parts) + "}"
+
     def joints(self) -> None:
         w = self.w
         joint = self.joint
         jf = [(r, f) for r in joint for f in r.fields]
         w("  // ---- joint blocks ---------------------------------------------------------------------")
-        w("  // Every joint's stored fields side by side (field offsets JO_*, JV_W bits per joint)")
-        off = "0"
-        for r, f in jf:
-            w(f"  localparam integer JO_{_base(r, f).upper()[6:]} = {off};")
-            off = f"JO_{_base(r, f).upper()[6:]} + {_fwidth(f)}"
-        w(f"  localparam integer JV_W = {off};")
-        w("  wire [NMAX*JV_W-1:0] jnt_vec;")
         if len(joint) == JOINT_WORDS:
             w("  // Every word of a joint block is a register.")
             w("  wire        rd_jnt_ok = 1'b1;")
@@ -885,7 +897,7 @@ class VerilogEmitter:
         w("        end")
         w("      end")
         w("")
-        w("      // Core-side outputs and the joint's stored fields for the read multiplexer")
+        w("      // Core-side outputs")
         for r, f in jf:
             wd = _fwidth(f)
             b = _base(r, f)
@@ -893,25 +905,77 @@ class VerilogEmitter:
                 w(f"      assign out_{b}[j] = {b}_q;")
             else:
                 w(f"      assign out_{b}[j*{wd} +: {wd}] = {b}_q;")
-            w(f"      assign jnt_vec[j*JV_W + JO_{b.upper()[6:]} +: {wd}] = {b}_q;")
         w("    end")
         w("  endgenerate")
         w("")
-        w("  // Read word of the addressed joint: the joint's stored fields (one NMAX:1 multiplexer tree,")
-        w("  // ts_sel, registered in rj_q), then the word, then the sign extension.  Selecting the joint")
-        w("  // first on the stored bits costs about a fifth of selecting every joint's sign-extended word")
-        w("  // (ECP5 LUT4).")
-        w("  wire [JV_W-1:0] rj;")
-        w("  reg  [JV_W-1:0] rj_q;")
-        w("  ts_sel #(.W(JV_W), .N(NMAX), .IW(6)) u_rd_joint (.in_vec(jnt_vec), .in_idx(ar_jidx), .out_el(rj));")
+        w("  // ---- joint read-back: a mirror of the joint blocks in block RAM ------------------------")
+        w("  // Every write to a joint block is also written, byte by byte as strobed, into jm_ram (NMAX x")
+        w("  // 16 words; one ECP5 DP16KD up to NMAX 32), and a read of a joint word takes it from there:")
+        w("  // the registers above stay the core's copy, but are not multiplexed for the bus (the NMAX:1")
+        w("  // multiplexer over every joint's fields it replaces: 1,222 ECP5 LUT4 at NMAX 8, -nowidelut).")
+        w("  // The RAM is not reset: jm_written (a bit per word, cleared by rst) tells whether a word has")
+        w("  // been written since the reset; an unwritten word reads as its reset value, and the first")
+        w("  // write of a word fills its unstrobed bytes with the reset value's.  A read and a write of")
+        w("  // the same word at the same edge read the old word, as the registers would.")
+        w("  localparam integer JM_AW = $clog2(NMAX * 16);")
+        w("  localparam integer JM_DEPTH = 1 << JM_AW;")
+        w("  (* ram_style = \"block\" *) reg [31:0] jm_ram [0:JM_DEPTH-1];")
+        w("  reg  [JM_DEPTH-1:0] jm_written;")
+        w("  wire [9:0]  jm_waddr_full = {wr_jidx, aw_word[3:0]};")
+        w("  wire [9:0]  jm_raddr_full = {ar_jidx, ar_word[3:0]};")
+        w("  wire [JM_AW-1:0] jm_waddr = jm_waddr_full[JM_AW-1:0];")
+        w("  wire [JM_AW-1:0] jm_raddr = jm_raddr_full[JM_AW-1:0];")
+        w("  generate")
+        w("    if (JM_AW < 10) begin : g_jm_unused")
+        w("      wire unused_jm = ^{jm_waddr_full[9:JM_AW], jm_raddr_full[9:JM_AW]};")
+        w("    end")
+        w("  endgenerate")
+        w("")
+        w("  // Reset value of the joint word at a word offset (a read word: fields in place, sign-extended)")
+        w("  function [31:0] jm_rst;")
+        w("    input [3:0] off;")
+        w("    begin")
+        w("      case (off)")
+        for r in joint:
+            w(f"        4'h{r.offset // 4:X}: jm_rst = {self.rst_word(r)};")
+        w("        default: jm_rst = 32'd0;")
+        w("      endcase")
+        w("    end")
+        w("  endfunction")
+        w("")
+        w("  wire        jm_we = wr_go && wr_jnt;")
+        w("  wire        jm_first = !jm_written[jm_waddr];   // first write since the reset")
+        w("  wire [31:0] jm_wrst = jm_rst(aw_word[3:0]);")
         w("  always @(posedge clk) begin")
-        w("    if (rst) rj_q <= {JV_W{1'b0}};")
-        w("    else if (ar_full) rj_q <= rj;")
+        w("    if (jm_we) begin")
+        for k in range(4):
+            hi, lo = 8 * k + 7, 8 * k
+            w(f"      if (w_strb[{k}] || jm_first) jm_ram[jm_waddr][{hi}:{lo}] <= "
+              f"w_strb[{k}] ? w_data[{hi}:{lo}] : jm_wrst[{hi}:{lo}];")
+        w("    end")
         w("  end")
+        w("  always @(posedge clk) begin")
+        w("    if (rst) jm_written <= {JM_DEPTH{1'b0}};")
+        w("    else if (jm_we) jm_written[jm_waddr] <= 1'b1;")
+        w("  end")
+        w("")
+        w("  // The read's first cycle: the addressed word and its written bit, registered")
+        w("  reg  [31:0] jm_q;")
+        w("  reg         jm_q_written;")
+        w("  always @(posedge clk) begin")
+        w("    if (ar_full && rd_jnt) jm_q <= jm_ram[jm_raddr];")
+        w("  end")
+        w("  always @(posedge clk) begin")
+        w("    if (rst) jm_q_written <= 1'b0;")
+        w("    else if (ar_full) jm_q_written <= rd_jnt && jm_written[jm_raddr];")
+        w("  end")
+        w("  wire [31:0] jm_word = jm_q_written ? jm_q : jm_rst(ar_word[3:0]);")
+        w("  wire        unused_jm_word = ^jm_word;    // the bits above the narrower formats")
+        w("  // Its stored fields, as the registers hold them (the read word rebuilt from them below)")
         for r, f in jf:
             b = _base(r, f)
             wd = _fwidth(f)
-            w(f"  wire {_decl(wd)}rj_{b[6:]} = rj_q[JO_{b.upper()[6:]} +: {wd}];")
+            w(f"  wire {_decl(wd)}rj_{b[6:]} = jm_word[{f.lsb} +: {wd}];")
         self.sext_block([(r, f) for r, f in jf if f.fmt], indent="  ", scope="", src="rj_{0}", strip=6)
         w("  reg  [31:0] rd_jnt_data;")
         w("  always @* begin")
