@@ -78,17 +78,21 @@ if cocotb is not None:
                 "in_" + port_base(r, f, False) for r in regs.GLOBAL.values() for f in r.fields if f.access == "ro"]
 
         # ---- set-up ------------------------------------------------------------------------------
-        async def reset(self) -> None:
+        async def pulse_reset(self, edges: int = 4) -> None:
+            """rst high for `edges` rising edges, released at a falling edge; the model reset too."""
             dut = self.dut
             dut.rst.value = 1
-            for _ in range(4):
+            for _ in range(edges):
                 await RisingEdge(dut.clk)
             await FallingEdge(dut.clk)
             dut.rst.value = 0
             self.model.reset()
+
+        async def reset(self) -> None:
+            await self.pulse_reset()
             cocotb.start_soon(self._count())
             cocotb.start_soon(self._monitor())
-            await FallingEdge(dut.clk)
+            await FallingEdge(self.dut.clk)
 
         async def _count(self) -> None:
             while True:
@@ -553,12 +557,7 @@ if cocotb is not None:
                     await tb.write(a, tb.rng.getrandbits(32) | 0x01010101, 0xF)
             await tb.check_all(f"round {rnd}, before the reset")
             await FallingEdge(dut.clk)
-            dut.rst.value = 1
-            for _ in range(3):
-                await RisingEdge(dut.clk)
-            await FallingEdge(dut.clk)
-            dut.rst.value = 0
-            tb.model.reset()
+            await tb.pulse_reset(3)
             await FallingEdge(dut.clk)
             tb.check_outputs(f"round {rnd}, after the reset")
             await tb.check_all(f"round {rnd}, after the reset")
