@@ -37,7 +37,11 @@ import rtlparams  # noqa: E402
 
 WORK = Path("build") / "synth"          # relative to ROOT (yowasp sandbox)
 DEVICE = ["--85k", "--package", "CABGA381", "--speed", "6"]
-PNR_FREQ = 200                          # MHz target given to nextpnr (only steers the placer)
+# MHz target given to nextpnr.  It sets the timing criticalities that weight the placer and
+# router2 (router2 scales a net's congestion cost by max(0.05, 1 - crit^2)); a failing target still
+# routes and reports the Fmax reached.  On the compact core, --freq 50 and 200 route identically
+# (docs/resources.md), so the target does not decide whether a design routes.
+PNR_FREQ = 200
 
 
 def sh(cmd: list[str], log: Path | None = None, timeout: int = 7200) -> subprocess.CompletedProcess:

@@ -272,8 +272,8 @@ DEFAULT_ROUTER = "router2"
 
 def nextpnr_cmd(dev_opt: str, js: Path, seed: int, log: Path, router: str = DEFAULT_ROUTER,
                 density: float | None = None) -> list[str]:
-    """One place-and-route run: out of context, speed grade 6, the Fmax target only steering the
-    placer (a failing target still routes and reports its Fmax).  density: the analytical placer's
+    """One place-and-route run: out of context, speed grade 6, the Fmax target synth.PNR_FREQ
+    weighting placement and routing (a failing target still routes and reports its Fmax).  density: the analytical placer's
     largest cell density (nextpnr's --placer-heap-beta; None: nextpnr's own), lower spreads the
     design for the router."""
     if router not in ROUTERS:
