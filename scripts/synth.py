@@ -38,8 +38,7 @@ import rtlparams  # noqa: E402
 WORK = Path("build") / "synth"          # relative to ROOT (yowasp sandbox)
 DEVICE = ["--85k", "--package", "CABGA381", "--speed", "6"]
 # MHz target given to nextpnr.  It sets the timing criticalities that weight the placer and
-# router2 (router2 scales a net's congestion cost by max(0.05, 1 - crit^2)); a failing target still
-# routes and reports the Fmax reached.  On the compact core, --freq 50 and 200 route identically
+# router2 against wirelength and congestion; a failing target still routes and reports the Fmax reached.  On the compact core, --freq 50 and 200 route identically
 # (docs/resources.md), so the target does not decide whether a design routes.
 PNR_FREQ = 200
 

@@ -272,7 +272,7 @@ DEFAULT_ROUTER = "router2"
 #: router2's growth of the present-congestion weight per iteration (nextpnr's setting
 #: router2/currCongWeightMult; nextpnr's own is 2.0).  At 2.0 router2 on the compact core on
 #: LFE5U-45F came within 9 overused wires and then diverged; at 1.5 it routes (docs/resources.md,
-#: session 30).  A slower growth lets the history costs, not the present ones, settle the last conflicts.
+#: session 30).
 CONG_MULT = 1.5
 
 
@@ -291,13 +291,19 @@ def with_settings(js: Path, settings: dict[str, str], out: Path) -> Path:
     return out
 
 
+def cong_mult_problem(cong_mult: float) -> str | None:
+    """What is wrong with a congestion growth (None: nothing): at 1 or below router2 cannot
+    converge, above 4 it is no longer a negotiation."""
+    return None if 1.0 < cong_mult <= 4.0 else f"{cong_mult:g} is outside (1, 4]"
+
+
 def router_settings(router: str, cong_mult: float | None) -> dict[str, str]:
     """The nextpnr settings a run carries in its netlist: router2's congestion growth (None:
     nextpnr's own); none for router1."""
     if cong_mult is None or router != "router2":
         return {}
-    if not 1.0 < cong_mult <= 4.0:
-        raise ValueError(f"cong_mult: {cong_mult:g} is outside (1, 4]")
+    if (why := cong_mult_problem(cong_mult)) is not None:
+        raise ValueError(f"cong_mult: {why}")
     return {"router2/currCongWeightMult": f"{cong_mult:g}"}
 
 
@@ -762,8 +768,8 @@ def main(argv: list[str] | None = None) -> int:
     a = ap.parse_args(argv)
     if a.lut_resets_below < 0:
         ap.error(f"--lut-resets-below: {a.lut_resets_below} is negative")
-    if not 1.0 < a.cong_mult <= 4.0:
-        ap.error(f"--cong-mult: {a.cong_mult:g} is outside (1, 4]")
+    if (why := cong_mult_problem(a.cong_mult)) is not None:
+        ap.error(f"--cong-mult: {why}")
     if a.route_minutes is not None and a.route_minutes <= 0:
         ap.error(f"--route-minutes: {a.route_minutes:g} is not positive")
     if a.doc_only:
