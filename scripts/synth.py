@@ -69,9 +69,19 @@ def versions() -> dict[str, str]:
         except SystemExit:
             continue
         out = sh([exe] + args)
-        text = (out.stdout + out.stderr).strip().splitlines()
-        v[name] = text[-1] if text else "?"
+        v[name] = version_line(out.stdout + "\n" + out.stderr)
     return v
+
+
+#: what a yowasp tool prints (on stderr) before its first run, while it compiles itself
+YOWASP_PREPARING = re.compile(r"^Preparing to run .*|^This might take a while", re.M)
+
+
+def version_line(text: str) -> str:
+    """The version line of a tool's output: its last non-empty line that is not the yowasp
+    wheels' one-time "Preparing to run ..." notice ("?" when there is none)."""
+    lines = [ln.strip() for ln in text.splitlines() if ln.strip() and not YOWASP_PREPARING.match(ln.strip())]
+    return lines[-1] if lines else "?"
 
 
 def yosys_script(module: str, params: dict, family: str, out_json: Path | None, stat: Path) -> str:

