@@ -308,8 +308,8 @@ ROUTER2_SETTINGS = {
 
 def router2_setting(text: str) -> tuple[str, str]:
     """One `NAME=VALUE` of --router2-setting as (nextpnr's key, value); NAME with or without its
-    `router2/` prefix.  ValueError (one line) for an unknown name, a value of the wrong type or a
-    negative one."""
+    `router2/` prefix.  ValueError (one line) for an unknown name, a value of the wrong type, a
+    negative one or an infinite one."""
     name, eq, value = text.partition("=")
     name = name.strip().removeprefix("router2/")
     if not eq or not name:
@@ -325,6 +325,8 @@ def router2_setting(text: str) -> tuple[str, str]:
         raise ValueError(f"{name}: {value.strip()!r} is not {'an integer' if kind is int else 'a number'}") from None
     if not v >= 0:                   # also refuses nan
         raise ValueError(f"{name}: {value.strip()} is negative")
+    if v == float("inf"):
+        raise ValueError(f"{name}: {value.strip()} is not finite")
     return f"router2/{name}", f"{v:g}" if kind is float else str(v)
 
 

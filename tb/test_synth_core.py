@@ -335,6 +335,7 @@ def test_router2_setting_parses_and_refuses(capsys):
                      ("histCongWeight=lots", "histCongWeight: 'lots' is not a number"),
                      ("histCongWeight=-1", "histCongWeight: -1 is negative"),
                      ("histCongWeight=nan", "histCongWeight: nan is negative"),
+                     ("histCongWeight=inf", "histCongWeight: inf is not finite"),
                      ("currCongWeightMult=1.3", "set by --cong-mult")):
         try:
             sc.router2_setting(bad)
