@@ -316,6 +316,8 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
                     jobs.append(("ts_quat_rotate", sources("ts_quat_rotate", target), quat_rotate(cfg, kind, inv, target)))
             for aw, bw in mul_shapes(cfg):
                 jobs.append(("ts_mul", sources("ts_mul", target), {"A_W": aw, "B_W": bw, "TARGET": target}))
+                if target == "ECP5":
+                    jobs.append(("ts_mul", sources("ts_mul", target), {"A_W": aw, "B_W": bw, "TARGET": target, "MUL3": 1}))
         for iw, sh, ow, sa in round_sat_sets(cfg):
             jobs.append(("ts_round_sat", sources("ts_round_sat"), {"IN_W": iw, "SHIFT": sh, "OUT_W": ow, "SAT": sa}))
     # the delay line: wire, register, shift register, rings in a memory (2, 16 and 24 words)

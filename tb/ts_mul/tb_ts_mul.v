@@ -19,7 +19,9 @@ module tb_ts_mul #(
   // instance 3
   parameter AW3 = 27, parameter BW3 = 18,
   // multiplier implementation
-  parameter TARGET = "GENERIC"
+  parameter TARGET = "GENERIC",
+  // ts_mul MUL3 (ECP5: three-multiplier wide products)
+  parameter MUL3 = 0
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -44,7 +46,7 @@ module tb_ts_mul #(
       localparam AW = (k == 0) ? AW0 : (k == 1) ? AW1 : (k == 2) ? AW2 : AW3;
       localparam BW = (k == 0) ? BW0 : (k == 1) ? BW1 : (k == 2) ? BW2 : BW3;
       wire signed [AW+BW-1:0] p;
-      ts_mul #(.A_W(AW), .B_W(BW), .TARGET(TARGET)) u_mul (
+      ts_mul #(.A_W(AW), .B_W(BW), .TARGET(TARGET), .MUL3(MUL3)) u_mul (
         .clk(clk), .rst(rst), .a(ina[64*k +: AW]), .b(inb[64*k +: BW]), .p(p));
       wire [AW+BW-1:0] pd;
       ts_delay #(.W(AW+BW), .DEPTH(LMAX - ts_mul_lat(AW, BW))) u_d (.clk(clk), .rst(rst), .din(p), .dout(pd));
