@@ -50,6 +50,8 @@ module ts_core_commit #(
   parameter CONFIG = 0,
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
   parameter TARGET = "GENERIC",
+  // ECP5 wide products on three MULT18X18D (see ts_mul)
+  parameter MUL3 = 0,
   // Register widths (as ts_servo_regs): derived from CONFIG, do not override
   parameter ANGLE_W = (CONFIG == 0) ? 32 : 18,
   parameter DT_W = (CONFIG == 0) ? 32 : 18,
@@ -433,7 +435,8 @@ module ts_core_commit #(
 
   // ---- the shared multiplier and the tag pipeline ------------------------------------------------
   wire signed [PW-1:0] p;
-  ts_mul #(.A_W(MA_W), .B_W(MB_W), .TARGET(TARGET)) u_mul (.clk(clk), .rst(rst), .a(op_a), .b(op_b), .p(p));
+  ts_mul #(.A_W(MA_W), .B_W(MB_W), .TARGET(TARGET), .MUL3(MUL3)) u_mul (
+    .clk(clk), .rst(rst), .a(op_a), .b(op_b), .p(p));
 
   wire [TAG_W-1:0] t_out = tpipe[TAG_W*LAT-1 -: TAG_W];
   wire             c_v = t_out[TAG_W-1];

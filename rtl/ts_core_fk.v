@@ -47,6 +47,8 @@ module ts_core_fk #(
   parameter ROM_FILE = "ts_trig_rom_default.mem",
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
   parameter TARGET = "GENERIC",
+  // ECP5 wide products on three MULT18X18D (see ts_mul)
+  parameter MUL3 = 0,
   // Products per multiplier of the quaternion product, the offset rotation and the screw
   // transport (ts_mul_bank); the columns are issued one per FOLD cycles
   parameter FOLD = 1,
@@ -296,7 +298,7 @@ module ts_core_fk #(
     .DELTA_F(TS_DELTA_F), .DSQ_W(TS_DSQ_W), .DSQ_F(TS_DSQ_F), .ACC_W(TS_TRIG_ACC_W),
     .ACC_F(TS_TRIG_ACC_F), .Q_W(Q_W), .Q_F(Q_F), .TWOPI_W(TS_TWOPI_W), .TWOPI_F(TS_TWOPI_F),
     .TWOPI(TWOPI), .SIXTH_W(TS_SIXTH_W), .SIXTH_F(TS_SIXTH_F), .SIXTH(SIXTH), .ROM_FILE(ROM_FILE),
-    .TARGET(TARGET)
+    .TARGET(TARGET), .MUL3(MUL3)
   ) u_jq (
     .clk(clk), .rst(rst), .in_valid(pre_valid), .in_angle(q_pre), .in_kturn(k_pre),
     .in_axis_x(ax_pre[0]), .in_axis_y(ax_pre[1]), .in_axis_z(ax_pre[2]),
@@ -306,7 +308,7 @@ module ts_core_fk #(
   // d = cvt<lever_t>(s q)
   localparam MLD = ts_mul_lat(S_W, ANG_W);
   wire signed [S_W+ANG_W-1:0] d_p;
-  ts_mul #(.A_W(S_W), .B_W(ANG_W), .TARGET(TARGET)) u_dm (
+  ts_mul #(.A_W(S_W), .B_W(ANG_W), .TARGET(TARGET), .MUL3(MUL3)) u_dm (
     .clk(clk), .rst(rst), .a(s_pre), .b(q_pre), .p(d_p));
   wire signed [L_W-1:0] d_o;
   wire d_sat;
@@ -324,7 +326,7 @@ module ts_core_fk #(
   reg signed [Q_W-1:0] qm_b [0:3];
   wire qm_ovalid, qm_sat;
   wire signed [Q_W-1:0] qm_o [0:3];
-  ts_quat_mul #(.Q_W(Q_W), .Q_F(Q_F), .TARGET(TARGET), .FOLD(FOLD), .CHAIN(CHAIN)) u_qm (
+  ts_quat_mul #(.Q_W(Q_W), .Q_F(Q_F), .TARGET(TARGET), .MUL3(MUL3), .FOLD(FOLD), .CHAIN(CHAIN)) u_qm (
     .clk(clk), .rst(rst), .in_valid(qm_valid),
     .in_a_w(qm_a[0]), .in_a_x(qm_a[1]), .in_a_y(qm_a[2]), .in_a_z(qm_a[3]),
     .in_b_w(qm_b[0]), .in_b_x(qm_b[1]), .in_b_y(qm_b[2]), .in_b_z(qm_b[3]),
@@ -338,7 +340,7 @@ module ts_core_fk #(
   wire signed [P_W-1:0] ro_o [0:2];
   ts_quat_rotate #(
     .Q_W(Q_W), .Q_F(Q_F), .V_W(LN_W), .V_F(LN_F), .T_W(TS_LEN_TMP_W), .T_F(TS_LEN_TMP_F),
-    .O_W(P_W), .O_F(P_F), .INV(0), .TARGET(TARGET), .FOLD(FOLD), .CHAIN(CHAIN)
+    .O_W(P_W), .O_F(P_F), .INV(0), .TARGET(TARGET), .MUL3(MUL3), .FOLD(FOLD), .CHAIN(CHAIN)
   ) u_ro (
     .clk(clk), .rst(rst), .in_valid(ro_valid),
     .in_q_w(qm_a[0]), .in_q_x(qm_a[1]), .in_q_y(qm_a[2]), .in_q_z(qm_a[3]),
@@ -393,7 +395,7 @@ module ts_core_fk #(
   ts_screw_transport #(
     .Q_W(Q_W), .Q_F(Q_F), .UT_W(TS_UVEC_TMP_W), .UT_F(TS_UVEC_TMP_F), .S_W(S_W), .S_F(S_F),
     .P_W(P_W), .P_F(P_F), .L_W(L_W), .L_F(L_F), .JW_W(JW_W), .JW_F(TS_JW_F), .JV_W(JV_W),
-    .JV_F(TS_JV_F), .TARGET(TARGET), .FOLD(FOLD), .CHAIN(CHAIN)
+    .JV_F(TS_JV_F), .TARGET(TARGET), .MUL3(MUL3), .FOLD(FOLD), .CHAIN(CHAIN)
   ) u_st (
     .clk(clk), .rst(rst), .in_valid(st_valid),
     .in_q_w(st_q[0]), .in_q_x(st_q[1]), .in_q_y(st_q[2]), .in_q_z(st_q[3]),
@@ -415,7 +417,7 @@ module ts_core_fk #(
   wire signed [P_W-1:0] pp_o [0:2];
   ts_delay #(.W(1), .DEPTH(MLP+1+RL)) u_ppv (.clk(clk), .rst(rst), .din(pp_valid), .dout(pp_ovalid));
   wire [3*(L_W+Q_W)-1:0] pp_p;
-  ts_mul_bank #(.N(3), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(L_W), .B_W(Q_W), .TARGET(TARGET)) u_mpp (
+  ts_mul_bank #(.N(3), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(L_W), .B_W(Q_W), .TARGET(TARGET), .MUL3(MUL3)) u_mpp (
     .clk(clk), .rst(rst), .in_valid(pp_valid), .in_a({rd_j, rd_j, rd_j}), .in_b({zr[2], zr[1], zr[0]}),
     .out_p(pp_p));
   generate

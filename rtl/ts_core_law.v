@@ -38,6 +38,8 @@ module ts_core_law #(
   parameter ROM_FILE = "ts_rotvec_rom_default.mem",
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
   parameter TARGET = "GENERIC",
+  // ECP5 wide products on three MULT18X18D (see ts_mul)
+  parameter MUL3 = 0,
   // Products per multiplier of the quaternion product and the column rotations (ts_mul_bank);
   // the column port's II
   parameter FOLD = 1,
@@ -259,7 +261,7 @@ module ts_core_law #(
       assign qm_b[gi] = r_mb ? uq[gi] : cq[gi];
     end
   endgenerate
-  ts_quat_mul #(.Q_W(Q_W), .Q_F(Q_F), .TARGET(TARGET), .FOLD(FOLD), .CHAIN(CHAIN)) u_qm (
+  ts_quat_mul #(.Q_W(Q_W), .Q_F(Q_F), .TARGET(TARGET), .MUL3(MUL3), .FOLD(FOLD), .CHAIN(CHAIN)) u_qm (
     .clk(clk), .rst(rst), .in_valid(b0),
     .in_a_w(qm_a[0]), .in_a_x(qm_a[1]), .in_a_y(qm_a[2]), .in_a_z(qm_a[3]),
     .in_b_w(qm_b[0]), .in_b_x(qm_b[1]), .in_b_y(qm_b[2]), .in_b_z(qm_b[3]),
@@ -310,7 +312,8 @@ module ts_core_law #(
   localparam MLF = ts_mul_lat(RV_W, FB + 1);
   localparam FS_W = RV_W + FB + 2;
   wire signed [RV_W+FB:0] fprod;
-  ts_mul #(.A_W(RV_W), .B_W(FB+1), .TARGET(TARGET)) u_fm (.clk(clk), .rst(rst), .a(tab_df), .b(wgt), .p(fprod));
+  ts_mul #(.A_W(RV_W), .B_W(FB+1), .TARGET(TARGET), .MUL3(MUL3)) u_fm (
+    .clk(clk), .rst(rst), .a(tab_df), .b(wgt), .p(fprod));
   wire signed [FS_W-1:0] fs_a, fs_b;
   ts_resize #(.IN_W(RV_W), .LSH(FB), .OUT_W(FS_W)) u_fsa (.in(tab_f), .out(fs_a));
   ts_resize #(.IN_W(RV_W+FB+1), .LSH(0), .OUT_W(FS_W)) u_fsb (.in(fprod), .out(fs_b));
@@ -332,7 +335,7 @@ module ts_core_law #(
   wire signed [RO_W-1:0] eo_o [0:2];
   wire [2:0] eo_sat;
   wire [3*(RV_W+Q_W)-1:0] eo_p;
-  ts_mul_bank #(.N(3), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(RV_W), .B_W(Q_W), .TARGET(TARGET)) u_meo (
+  ts_mul_bank #(.N(3), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(RV_W), .B_W(Q_W), .TARGET(TARGET), .MUL3(MUL3)) u_meo (
     .clk(clk), .rst(rst), .in_valid(c2), .in_a({fr, fr, fr}), .in_b({qn[3], qn[2], qn[1]}), .out_p(eo_p));
   generate
     for (gi = 0; gi < 3; gi = gi + 1) begin : g_eo
@@ -352,7 +355,7 @@ module ts_core_law #(
   wire [2:0] lev_sat;
   // products 2 c and 2 c + 1 of component c: dp[j] w[k] and dp[k] w[j], (j, k) = (c+1, c+2) mod 3
   wire [6*X_W-1:0] lev_p;
-  ts_mul_bank #(.N(6), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(PE_W), .B_W(V_W), .TARGET(TARGET)) u_mlev (
+  ts_mul_bank #(.N(6), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(PE_W), .B_W(V_W), .TARGET(TARGET), .MUL3(MUL3)) u_mlev (
     .clk(clk), .rst(rst), .in_valid(b0),
     .in_a({dp[1], dp[0], dp[0], dp[2], dp[2], dp[1]}), .in_b({uw[0], uw[1], uw[2], uw[0], uw[1], uw[2]}),
     .out_p(lev_p));
@@ -448,7 +451,7 @@ module ts_core_law #(
   // stage A: t = 2 (q_v x v) with q_v negated (INV): products (y a2, z a1), (z a0, x a2), (x a1, y a0)
   wire signed [RA_W-1:0] ra [0:5];
   wire [6*RA_W-1:0] ra_p;
-  ts_mul_bank #(.N(6), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(Q_W), .B_W(VI_W), .TARGET(TARGET)) u_mra (
+  ts_mul_bank #(.N(6), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(Q_W), .B_W(VI_W), .TARGET(TARGET), .MUL3(MUL3)) u_mra (
     .clk(clk), .rst(rst), .in_valid(rot_valid),
     .in_a({tq[2], tq[1], tq[1], tq[3], tq[3], tq[2]}), .in_b({rv[0], rv[1], rv[2], rv[0], rv[1], rv[2]}),
     .out_p(ra_p));
@@ -490,7 +493,7 @@ module ts_core_law #(
   wire rb_valid;
   ts_delay #(.W(1), .DEPTH(RLA)) u_rbv (.clk(clk), .rst(rst), .din(rot_valid), .dout(rb_valid));
   wire [9*RB_W-1:0] rb_p;
-  ts_mul_bank #(.N(9), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(Q_W), .B_W(TT_W), .TARGET(TARGET)) u_mrb (
+  ts_mul_bank #(.N(9), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(Q_W), .B_W(TT_W), .TARGET(TARGET), .MUL3(MUL3)) u_mrb (
     .clk(clk), .rst(rst), .in_valid(rb_valid),
     .in_a({tq[1], tq[2], tq[3], tq[1], tq[2], tq[3], tq[0], tq[0], tq[0]}),
     .in_b({rt[1], rt[0], rt[0], rt[2], rt[2], rt[1], rt[2], rt[1], rt[0]}),
@@ -574,7 +577,7 @@ module ts_core_law #(
   wire [2:0] vw_sat, vv_sat;
   // products 0-2: ko eo_i; 3-5: kp ep_i (rot_t and perr_t have the same width)
   wire [6*(G_W+RO_W)-1:0] gv_p;
-  ts_mul_bank #(.N(6), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(G_W), .B_W(RO_W), .TARGET(TARGET)) u_mg (
+  ts_mul_bank #(.N(6), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(G_W), .B_W(RO_W), .TARGET(TARGET), .MUL3(MUL3)) u_mg (
     .clk(clk), .rst(rst), .in_valid(d0),
     .in_a({r_kp, r_kp, r_kp, r_ko, r_ko, r_ko}), .in_b({ep[2], ep[1], ep[0], eo[2], eo[1], eo[0]}),
     .out_p(gv_p));
@@ -739,7 +742,7 @@ module ts_core_law #(
   wire signed [JV_W-1:0] cv_o [0:2];
   ts_quat_rotate #(
     .Q_W(Q_W), .Q_F(Q_F), .V_W(JW_W), .V_F(TS_JW_F), .T_W(TS_JW_TMP_W), .T_F(TS_JW_TMP_F),
-    .O_W(JW_W), .O_F(TS_JW_F), .INV(1), .TARGET(TARGET), .FOLD(FOLD), .CHAIN(CHAIN)
+    .O_W(JW_W), .O_F(TS_JW_F), .INV(1), .TARGET(TARGET), .MUL3(MUL3), .FOLD(FOLD), .CHAIN(CHAIN)
   ) u_cw (
     .clk(clk), .rst(rst), .in_valid(in_col_valid),
     .in_q_w(tq[0]), .in_q_x(tq[1]), .in_q_y(tq[2]), .in_q_z(tq[3]),
@@ -747,7 +750,7 @@ module ts_core_law #(
     .out_valid(col_ovalid), .out_x(cw_o[0]), .out_y(cw_o[1]), .out_z(cw_o[2]), .out_sat(col_sw));
   ts_quat_rotate #(
     .Q_W(Q_W), .Q_F(Q_F), .V_W(JV_W), .V_F(TS_JV_F), .T_W(TS_JV_TMP_W), .T_F(TS_JV_TMP_F),
-    .O_W(JV_W), .O_F(TS_JV_F), .INV(1), .TARGET(TARGET), .FOLD(FOLD), .CHAIN(CHAIN)
+    .O_W(JV_W), .O_F(TS_JV_F), .INV(1), .TARGET(TARGET), .MUL3(MUL3), .FOLD(FOLD), .CHAIN(CHAIN)
   ) u_cv (
     .clk(clk), .rst(rst), .in_valid(in_col_valid),
     .in_q_w(tq[0]), .in_q_x(tq[1]), .in_q_y(tq[2]), .in_q_z(tq[3]),

@@ -49,6 +49,8 @@ module ts_core_solve #(
   parameter ROM_FILE = "ts_recip_rom_default.mem",
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
   parameter TARGET = "GENERIC",
+  // ECP5 wide products on three MULT18X18D (see ts_mul)
+  parameter MUL3 = 0,
   // Sweep count width
   parameter SW_W = 16,
   // Joint index width: derived from NMAX, do not override
@@ -387,7 +389,8 @@ module ts_core_solve #(
   reg signed [MAW-1:0] mul_a;
   reg signed [MBW-1:0] mul_b;
   wire signed [PW-1:0] p;
-  ts_mul #(.A_W(MAW), .B_W(MBW), .TARGET(TARGET)) u_mul (.clk(clk), .rst(rst), .a(mul_a), .b(mul_b), .p(p));
+  ts_mul #(.A_W(MAW), .B_W(MBW), .TARGET(TARGET), .MUL3(MUL3)) u_mul (
+    .clk(clk), .rst(rst), .a(mul_a), .b(mul_b), .p(p));
 
   reg signed [MAW-1:0] a_sel;
   reg signed [MBW-1:0] b_sel;

@@ -61,7 +61,9 @@ module ts_joint_quat #(
   // Table memory file of ts_sincos
   parameter ROM_FILE = "ts_trig_rom_default.mem",
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
-  parameter TARGET = "GENERIC"
+  parameter TARGET = "GENERIC",
+  // ECP5 wide products on three MULT18X18D (see ts_mul)
+  parameter MUL3 = 0
 ) (
   input  wire                    clk,
   input  wire                    rst,
@@ -95,7 +97,7 @@ module ts_joint_quat #(
 
   // ---- u = wrap<turn_t>(angle kturn) -----------------------------------------------------------
   wire signed [ANG_W+KT_W-1:0] pk;
-  ts_mul #(.A_W(ANG_W), .B_W(KT_W), .TARGET(TARGET)) u_mk (
+  ts_mul #(.A_W(ANG_W), .B_W(KT_W), .TARGET(TARGET), .MUL3(MUL3)) u_mk (
     .clk(clk), .rst(rst), .a(in_angle), .b(in_kturn), .p(pk));
   wire signed [U_W-1:0] u;
   wire unused_wrap_flag;
@@ -112,7 +114,7 @@ module ts_joint_quat #(
     .U_W(U_W), .T_BITS(T_BITS), .TAB_W(TAB_W), .TAB_F(TAB_F), .DELTA_W(DELTA_W), .DELTA_F(DELTA_F),
     .DSQ_W(DSQ_W), .DSQ_F(DSQ_F), .ACC_W(ACC_W), .ACC_F(ACC_F), .Q_W(Q_W), .Q_F(Q_F),
     .TWOPI_W(TWOPI_W), .TWOPI_F(TWOPI_F), .TWOPI(TWOPI), .SIXTH_W(SIXTH_W), .SIXTH_F(SIXTH_F),
-    .SIXTH(SIXTH), .ROM_FILE(ROM_FILE), .TARGET(TARGET)
+    .SIXTH(SIXTH), .ROM_FILE(ROM_FILE), .TARGET(TARGET), .MUL3(MUL3)
   ) u_sincos (
     .clk(clk), .rst(rst), .in_valid(wrap_valid), .in_u(u), .out_valid(sc_valid),
     .out_sin(sn), .out_cos(cs), .out_flags(sc_flags));
@@ -127,7 +129,7 @@ module ts_joint_quat #(
   generate
     for (i = 0; i < 3; i = i + 1) begin : g_v
       wire signed [2*Q_W-1:0] pv;
-      ts_mul #(.A_W(Q_W), .B_W(Q_W), .TARGET(TARGET)) u_mv (
+      ts_mul #(.A_W(Q_W), .B_W(Q_W), .TARGET(TARGET), .MUL3(MUL3)) u_mv (
         .clk(clk), .rst(rst), .a(sn), .b(axis_d[Q_W*i +: Q_W]), .p(pv));
       ts_round_sat #(.IN_W(2*Q_W), .SHIFT(Q_F), .OUT_W(Q_W), .SAT(1)) u_rv (
         .clk(clk), .rst(rst), .in_x(pv), .out_y(v[i]), .out_sat(sat_v[i]));

@@ -25,6 +25,8 @@ module ts_mul_bank #(
   parameter B_W = 18,
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
   parameter TARGET = "GENERIC",
+  // ECP5 wide products on three MULT18X18D (see ts_mul)
+  parameter MUL3 = 0,
   // FOLD > 1: how the held operands reach the multipliers.  0: held once, a FOLD:1 select per
   // multiplier input; 1: shift chains per multiplier, for operands and products (more registers
   // and LUTs, shorter wires; docs/rtl/shared.md).  The bits and the latency never depend on it.
@@ -53,7 +55,7 @@ module ts_mul_bank #(
 
     if (FOLD == 1) begin : g_par
       for (l = 0; l < N; l = l + 1) begin : g_m
-        ts_mul #(.A_W(A_W), .B_W(B_W), .TARGET(TARGET)) u_m (
+        ts_mul #(.A_W(A_W), .B_W(B_W), .TARGET(TARGET), .MUL3(MUL3)) u_m (
           .clk(clk), .rst(rst), .a(in_a[l*A_W +: A_W]), .b(in_b[l*B_W +: B_W]), .p(out_p[l*P_W +: P_W]));
       end
       wire unused_valid = in_valid;
@@ -138,7 +140,7 @@ module ts_mul_bank #(
           ts_sel #(.W(A_W), .N(FOLD), .IW(PH_W)) u_sa (.in_vec(ca), .in_idx(sel), .out_el(a_l));
           ts_sel #(.W(B_W), .N(FOLD), .IW(PH_W)) u_sb (.in_vec(cb), .in_idx(sel), .out_el(b_l));
           wire signed [P_W-1:0] p_l;
-          ts_mul #(.A_W(A_W), .B_W(B_W), .TARGET(TARGET)) u_m (
+          ts_mul #(.A_W(A_W), .B_W(B_W), .TARGET(TARGET), .MUL3(MUL3)) u_m (
             .clk(clk), .rst(rst), .a(a_l), .b(b_l), .p(p_l));
 
           // products of the phases before the last are held; the last phase's pass through
@@ -176,7 +178,7 @@ module ts_mul_bank #(
           wire [A_W-1:0] a_l = in_valid ? pa[l*A_W +: A_W] : ha[l*A_W +: A_W];
           wire [B_W-1:0] b_l = in_valid ? pb[l*B_W +: B_W] : hb[l*B_W +: B_W];
           wire signed [P_W-1:0] p_l;
-          ts_mul #(.A_W(A_W), .B_W(B_W), .TARGET(TARGET)) u_m (
+          ts_mul #(.A_W(A_W), .B_W(B_W), .TARGET(TARGET), .MUL3(MUL3)) u_m (
             .clk(clk), .rst(rst), .a(a_l), .b(b_l), .p(p_l));
 
           // Products of the phases before the last, held in a shift chain (phase c at [c*P_W] in

@@ -21,6 +21,8 @@ module ts_quat_mul #(
   parameter Q_F = 25,
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
   parameter TARGET = "GENERIC",
+  // ECP5 wide products on three MULT18X18D (see ts_mul)
+  parameter MUL3 = 0,
   // Products per multiplier (cycles per product, II); 1: 16 multipliers in parallel
   parameter FOLD = 1,
   // Folded multiplier banks (FOLD > 1): 1 holds their operands and products in shift chains
@@ -72,7 +74,7 @@ module ts_quat_mul #(
       end
     end
   endgenerate
-  ts_mul_bank #(.N(16), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(Q_W), .B_W(Q_W), .TARGET(TARGET)) u_bank (
+  ts_mul_bank #(.N(16), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(Q_W), .B_W(Q_W), .TARGET(TARGET), .MUL3(MUL3)) u_bank (
     .clk(clk), .rst(rst), .in_valid(in_valid), .in_a(ba), .in_b(bb), .out_p(bp));
 
   // Level 1: eight pairwise sums, P_W + 1 bits (exact).

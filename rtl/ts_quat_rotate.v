@@ -37,6 +37,8 @@ module ts_quat_rotate #(
   parameter INV = 0,
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
   parameter TARGET = "GENERIC",
+  // ECP5 wide products on three MULT18X18D (see ts_mul)
+  parameter MUL3 = 0,
   // Products per multiplier (cycles per vector, II); 1: 15 multipliers in parallel
   parameter FOLD = 1,
   // Folded multiplier banks (FOLD > 1): 1 holds their operands and products in shift chains
@@ -73,7 +75,7 @@ module ts_quat_rotate #(
   wire signed [PA_W-1:0] pa [0:5];
   // Products in the order of the three differences: (y a2, z a1), (z a0, x a2), (x a1, y a0).
   wire [6*PA_W-1:0] pa_bus;
-  ts_mul_bank #(.N(6), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(Q_W), .B_W(V_W), .TARGET(TARGET)) u_pa (
+  ts_mul_bank #(.N(6), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(Q_W), .B_W(V_W), .TARGET(TARGET), .MUL3(MUL3)) u_pa (
     .clk(clk), .rst(rst), .in_valid(in_valid),
     .in_a({in_q_y, in_q_x, in_q_x, in_q_z, in_q_z, in_q_y}),
     .in_b({in_v_x, in_v_y, in_v_z, in_v_x, in_v_y, in_v_z}),
@@ -131,7 +133,7 @@ module ts_quat_rotate #(
   // products 0-2: w t_i; 3-8: the cross terms, same order as stage A: (y b2, z b1), (z b0, x b2),
   // (x b1, y b0)
   wire [9*PB_W-1:0] pb_bus;
-  ts_mul_bank #(.N(9), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(Q_W), .B_W(T_W), .TARGET(TARGET)) u_pb (
+  ts_mul_bank #(.N(9), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(Q_W), .B_W(T_W), .TARGET(TARGET), .MUL3(MUL3)) u_pb (
     .clk(clk), .rst(rst), .in_valid(b_valid),
     .in_a({y_b, x_b, x_b, z_b, z_b, y_b, w_b, w_b, w_b}),
     .in_b({t[0], t[1], t[2], t[0], t[1], t[2], t[2], t[1], t[0]}),

@@ -47,6 +47,8 @@ module ts_screw_transport #(
   parameter JV_F = 22,
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
   parameter TARGET = "GENERIC",
+  // ECP5 wide products on three MULT18X18D (see ts_mul)
+  parameter MUL3 = 0,
   // Products per multiplier (cycles per column, II); 1: 24 multipliers in parallel
   parameter FOLD = 1,
   // Folded multiplier banks (FOLD > 1): 1 holds their operands and products in shift chains
@@ -103,7 +105,7 @@ module ts_screw_transport #(
   wire z_valid, z_sat;
   ts_quat_rotate #(
     .Q_W(Q_W), .Q_F(Q_F), .V_W(Q_W), .V_F(Q_F), .T_W(UT_W), .T_F(UT_F), .O_W(Q_W), .O_F(Q_F),
-    .INV(0), .TARGET(TARGET), .FOLD(FOLD), .CHAIN(CHAIN)
+    .INV(0), .TARGET(TARGET), .MUL3(MUL3), .FOLD(FOLD), .CHAIN(CHAIN)
   ) u_rot (
     .clk(clk), .rst(rst), .in_valid(in_valid),
     .in_q_w(in_q_w), .in_q_x(in_q_x), .in_q_y(in_q_y), .in_q_z(in_q_z),
@@ -138,7 +140,7 @@ module ts_screw_transport #(
   wire signed [JV_W-1:0] vp [0:2];
   wire [2:0] sat_w, sat_vp;
   wire [3*(S_W+Q_W)-1:0] psz_bus;
-  ts_mul_bank #(.N(3), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(S_W), .B_W(Q_W), .TARGET(TARGET)) u_msz (
+  ts_mul_bank #(.N(3), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(S_W), .B_W(Q_W), .TARGET(TARGET), .MUL3(MUL3)) u_msz (
     .clk(clk), .rst(rst), .in_valid(z_valid), .in_a({s_d, s_d, s_d}), .in_b({z[2], z[1], z[0]}),
     .out_p(psz_bus));
   generate
@@ -158,7 +160,7 @@ module ts_screw_transport #(
   wire w_valid;
   ts_delay #(.W(1), .DEPTH(C_W)) u_wv (.clk(clk), .rst(rst), .din(in_valid), .dout(w_valid));
   wire [6*PC_W-1:0] pc_bus;
-  ts_mul_bank #(.N(6), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(JW_W), .B_W(L_W), .TARGET(TARGET)) u_mc (
+  ts_mul_bank #(.N(6), .FOLD(FOLD), .CHAIN(CHAIN), .A_W(JW_W), .B_W(L_W), .TARGET(TARGET), .MUL3(MUL3)) u_mc (
     .clk(clk), .rst(rst), .in_valid(w_valid),
     .in_a({w[1], w[0], w[0], w[2], w[2], w[1]}), .in_b({r[0], r[1], r[2], r[0], r[1], r[2]}),
     .out_p(pc_bus));

@@ -33,7 +33,11 @@ module ts_servo_core #(
   parameter FOLD = (CONFIG == 0) ? 9 : 7,
   // 1: the FK and law engines' folded banks hold operands and products in shift chains (the same
   // bits and cycles; more registers and LUTs, shorter wires: docs/resources.md has both on ECP5).
-  parameter CHAIN = 0
+  parameter CHAIN = 0,
+  // 1: ECP5 products with both operands of 19-33 bits on three MULT18X18D instead of four
+  // (ts_mul MUL3: the same bits and cycles, more LUTs; docs/resources.md).  No effect on "GENERIC"
+  // or on the compact configuration, whose operands are all <= 18 bits.
+  parameter MUL3 = 0
 ) (
   input  wire        clk,
   input  wire        rst,
@@ -175,7 +179,7 @@ module ts_servo_core #(
   wire [ANGLE_W-1:0] j_lo, j_hi;
   wire [QD_W-1:0] j_vm;
   wire [MU_W-1:0] j_mu;
-  ts_core_commit #(.NMAX(NMAX), .CONFIG(CONFIG), .TARGET(TARGET)) u_commit (
+  ts_core_commit #(.NMAX(NMAX), .CONFIG(CONFIG), .TARGET(TARGET), .MUL3(MUL3)) u_commit (
     .clk(clk), .rst(rst), .in_start(c_start),
     .in_njoints(r_njoints), .in_mode_err_b(r_err_b), .in_mode_error_only(r_err_only),
     .in_mode_sweeps(r_sweeps), .in_mode_warm_leak(r_leak), .in_kp(r_kp), .in_ko(r_ko),
@@ -392,7 +396,8 @@ module ts_servo_core #(
   wire signed [JV_W-1:0] fc_vx, fc_vy, fc_vz;
   wire signed [P_W-1:0] fc_px, fc_py, fc_pz;
 
-  ts_core_fk #(.NMAX(NMAX), .CONFIG(CONFIG), .ROM_FILE(TRIG_ROM), .TARGET(TARGET), .FOLD(FOLD), .CHAIN(CHAIN)) u_fk (
+  ts_core_fk #(.NMAX(NMAX), .CONFIG(CONFIG), .ROM_FILE(TRIG_ROM),
+    .TARGET(TARGET), .MUL3(MUL3), .FOLD(FOLD), .CHAIN(CHAIN)) u_fk (
     .clk(clk), .rst(rst),
     .in_cfg_we(fk_we_q), .in_cfg_addr(ld_q), .in_cfg_data(fk_cd_q),
     .in_q_we(in_prep && !psub), .in_q_addr(pjj), .in_q_data(q_sel),
@@ -417,7 +422,8 @@ module ts_servo_core #(
   wire signed [JW_W-1:0] lc_wx, lc_wy, lc_wz;
   wire signed [JV_W-1:0] lc_vx, lc_vy, lc_vz;
 
-  ts_core_law #(.CONFIG(CONFIG), .ROM_FILE(ROTVEC_ROM), .TARGET(TARGET), .FOLD(FOLD), .CHAIN(CHAIN)) u_law (
+  ts_core_law #(.CONFIG(CONFIG), .ROM_FILE(ROTVEC_ROM),
+    .TARGET(TARGET), .MUL3(MUL3), .FOLD(FOLD), .CHAIN(CHAIN)) u_law (
     .clk(clk), .rst(rst), .in_start(law_start), .in_mode_b(c_err_b), .in_err_only(c_err_only),
     .in_kp(c_kp), .in_ko(c_ko), .out_busy(law_busy), .out_done(law_done), .out_flags(law_flags),
     .in_tool_q_w(tq_w), .in_tool_q_x(tq_x), .in_tool_q_y(tq_y), .in_tool_q_z(tq_z),
@@ -480,7 +486,7 @@ module ts_servo_core #(
     end
   end
 
-  ts_core_solve #(.NMAX(NMAX), .CONFIG(CONFIG), .ROM_FILE(RECIP_ROM), .TARGET(TARGET)) u_solve (
+  ts_core_solve #(.NMAX(NMAX), .CONFIG(CONFIG), .ROM_FILE(RECIP_ROM), .TARGET(TARGET), .MUL3(MUL3)) u_solve (
     .clk(clk), .rst(rst),
     .in_cfg_we(sv_we_q), .in_cfg_addr(ld_q), .in_cfg_data(sv_cd_q),
     .in_x_we(sv_xwe), .in_x_addr(sv_xa), .in_x_data(sv_xd),

@@ -58,7 +58,9 @@ module ts_sincos #(
   // Table memory file ($readmemh): word k = {S_k, C_k}, each TAB_W bits
   parameter ROM_FILE = "ts_trig_rom_default.mem",
   // Multiplier implementation: "GENERIC" or "ECP5" (see ts_mul)
-  parameter TARGET = "GENERIC"
+  parameter TARGET = "GENERIC",
+  // ECP5 wide products on three MULT18X18D (see ts_mul)
+  parameter MUL3 = 0
 ) (
   input  wire                  clk,
   input  wire                  rst,
@@ -103,7 +105,7 @@ module ts_sincos #(
   localparam signed [TWOPI_W-1:0] K_TWOPI = TWOPI[TWOPI_W-1:0];
   localparam signed [SIXTH_W-1:0] K_SIXTH = SIXTH[SIXTH_W-1:0];
   wire signed [R+TWOPI_W:0] p1;
-  ts_mul #(.A_W(R+1), .B_W(TWOPI_W), .TARGET(TARGET)) u_m1 (
+  ts_mul #(.A_W(R+1), .B_W(TWOPI_W), .TARGET(TARGET), .MUL3(MUL3)) u_m1 (
     .clk(clk), .rst(rst), .a(residual), .b(K_TWOPI), .p(p1));
   wire signed [DELTA_W-1:0] d;
   wire sat_d;
@@ -112,7 +114,7 @@ module ts_sincos #(
 
   // ---- d2 = cvt<dsq_t>(d d) -------------------------------------------------------------------
   wire signed [2*DELTA_W-1:0] p2;
-  ts_mul #(.A_W(DELTA_W), .B_W(DELTA_W), .TARGET(TARGET)) u_m2 (
+  ts_mul #(.A_W(DELTA_W), .B_W(DELTA_W), .TARGET(TARGET), .MUL3(MUL3)) u_m2 (
     .clk(clk), .rst(rst), .a(d), .b(d), .p(p2));
   wire signed [DSQ_W-1:0] d2;
   wire sat_d2;
@@ -121,7 +123,7 @@ module ts_sincos #(
 
   // ---- e = cvt<dsq_t>(d2 sixth) ---------------------------------------------------------------
   wire signed [DSQ_W+SIXTH_W-1:0] p3;
-  ts_mul #(.A_W(DSQ_W), .B_W(SIXTH_W), .TARGET(TARGET)) u_m3 (
+  ts_mul #(.A_W(DSQ_W), .B_W(SIXTH_W), .TARGET(TARGET), .MUL3(MUL3)) u_m3 (
     .clk(clk), .rst(rst), .a(d2), .b(K_SIXTH), .p(p3));
   wire signed [DSQ_W-1:0] e;
   wire sat_e;
@@ -132,7 +134,7 @@ module ts_sincos #(
   wire [DELTA_W-1:0] d_at_e;
   ts_delay #(.W(DELTA_W), .DEPTH(C_E-C_D)) u_dd1 (.clk(clk), .rst(rst), .din(d), .dout(d_at_e));
   wire signed [DELTA_W+DSQ_W-1:0] p4;
-  ts_mul #(.A_W(DELTA_W), .B_W(DSQ_W), .TARGET(TARGET)) u_m4 (
+  ts_mul #(.A_W(DELTA_W), .B_W(DSQ_W), .TARGET(TARGET), .MUL3(MUL3)) u_m4 (
     .clk(clk), .rst(rst), .a(d_at_e), .b(e), .p(p4));
   wire signed [DELTA_W-1:0] de;
   wire sat_de;
@@ -189,10 +191,14 @@ module ts_sincos #(
   ts_delay #(.W(2*TAB_W), .DEPTH(ML6-ML6S)) u_tds (.clk(clk), .rst(rst), .din(rom_q), .dout({tab_s_s, tab_c_s}));
   wire signed [TAB_W+DSQ_W-1:0] p_sh, p_ch;
   wire signed [TAB_W+DELTA_W-1:0] p_csd, p_ssd;
-  ts_mul #(.A_W(TAB_W), .B_W(DSQ_W), .TARGET(TARGET)) u_msh (.clk(clk), .rst(rst), .a(tab_s_h), .b(h), .p(p_sh));
-  ts_mul #(.A_W(TAB_W), .B_W(DSQ_W), .TARGET(TARGET)) u_mch (.clk(clk), .rst(rst), .a(tab_c_h), .b(h), .p(p_ch));
-  ts_mul #(.A_W(TAB_W), .B_W(DELTA_W), .TARGET(TARGET)) u_mcs (.clk(clk), .rst(rst), .a(tab_c_s), .b(sd_m), .p(p_csd));
-  ts_mul #(.A_W(TAB_W), .B_W(DELTA_W), .TARGET(TARGET)) u_mss (.clk(clk), .rst(rst), .a(tab_s_s), .b(sd_m), .p(p_ssd));
+  ts_mul #(.A_W(TAB_W), .B_W(DSQ_W), .TARGET(TARGET), .MUL3(MUL3)) u_msh (
+    .clk(clk), .rst(rst), .a(tab_s_h), .b(h), .p(p_sh));
+  ts_mul #(.A_W(TAB_W), .B_W(DSQ_W), .TARGET(TARGET), .MUL3(MUL3)) u_mch (
+    .clk(clk), .rst(rst), .a(tab_c_h), .b(h), .p(p_ch));
+  ts_mul #(.A_W(TAB_W), .B_W(DELTA_W), .TARGET(TARGET), .MUL3(MUL3)) u_mcs (
+    .clk(clk), .rst(rst), .a(tab_c_s), .b(sd_m), .p(p_csd));
+  ts_mul #(.A_W(TAB_W), .B_W(DELTA_W), .TARGET(TARGET), .MUL3(MUL3)) u_mss (
+    .clk(clk), .rst(rst), .a(tab_s_s), .b(sd_m), .p(p_ssd));
   wire signed [ACC_W-1:0] a_sh, a_ch, a_csd, a_ssd;
   wire [3:0] sat_acc;
   ts_round_sat #(.IN_W(TAB_W+DSQ_W), .SHIFT(TAB_F+DSQ_F+1-ACC_F), .OUT_W(ACC_W), .SAT(1)) u_rsh (

@@ -391,6 +391,8 @@ def lint_jobs() -> list[tuple[str, list[str], dict]]:
         for fold in (1, 9):
             jobs.append(("ts_servo_core", sources("ts_servo_core"), dict(servo_core(CONFIGS[config], "GENERIC", 8), FOLD=fold)))
         jobs.append(("ts_servo_core", sources("ts_servo_core", "ECP5"), dict(servo_core(CONFIGS[config], "ECP5", 8), CHAIN=1)))
+        # three-multiplier wide products (ts_mul MUL3)
+        jobs.append(("ts_servo_core", sources("ts_servo_core", "ECP5"), dict(servo_core(CONFIGS[config], "ECP5", 8), MUL3=1)))
     return jobs
 
 

@@ -1,5 +1,6 @@
 """scripts/synth_core.py: reading nextpnr's critical path report (the last one in the log, which is
 the post-route one), on a log excerpt in nextpnr 0.11's format written for the test."""
+import json
 import subprocess
 import sys
 import time
@@ -277,11 +278,11 @@ def test_no_widelut_reaches_the_engine_runs(tmp_path, monkeypatch):
     sc = synth_core
     got = {}
 
-    def fake_run(cfg, seeds, pnr, router, place_on, below, minutes, widelut, cong_mult, router2):
+    def fake_run(cfg, seeds, pnr, router, place_on, below, minutes, widelut, cong_mult, router2, mul3):
         got["run"] = widelut
         return {}
 
-    def fake_engines(cfg, opt, seed, jobs, router, widelut=True):
+    def fake_engines(cfg, opt, seed, jobs, router, widelut=True, mul3=False):
         got["engines"] = widelut
         return {}
 
@@ -295,6 +296,46 @@ def test_no_widelut_reaches_the_engine_runs(tmp_path, monkeypatch):
         assert sc.main(["--configs", "compact", "--engines", "--json", str(tmp_path / "r.json"), "--out", ""]
                        + flag) == 0
         assert got == {"run": want, "engines": want}
+
+
+def test_mul3_reaches_every_core_synthesis(tmp_path, monkeypatch):
+    """--mul3: the core's MUL3 = 1 is set in every yosys run that elaborates it (hierarchical,
+    flattened, the --lut-resets-below flow's reading, the engines' derivation and each engine alone),
+    and in none without it; main hands it to both kinds of run and records it; the doc section says so."""
+    sc = synth_core
+    for mul3 in (False, True):
+        texts = [sc.yosys_core_script("default", tmp_path / "a.json", tmp_path / "s.txt", hier=h, mul3=mul3)
+                 for h in (True, False)]
+        texts.append("\n".join(sc.yosys_read_lines("default", mul3)))
+        texts.append(sc.yosys_engine_script("default", "ts_core_fk_derived", tmp_path / "e.json", tmp_path / "e.txt",
+                                            mul3=mul3))
+        for t in texts:
+            ch = [ln for ln in t.splitlines() if ln.startswith("chparam") and ln.endswith(" ts_servo_core")]
+            assert len(ch) == 1 and ("-set MUL3 1 " in ch[0]) == mul3, ch
+    got = {}
+
+    def fake_run(cfg, seeds, pnr, router, place_on, below, minutes, widelut, cong_mult, router2, mul3):
+        got["run"] = mul3
+        return {}
+
+    def fake_engines(cfg, opt, seed, jobs, router, widelut=True, mul3=False):
+        got["engines"] = mul3
+        return {}
+
+    monkeypatch.setattr(sc, "run", fake_run)
+    monkeypatch.setattr(sc, "run_engines", fake_engines)
+    monkeypatch.setattr(sc, "measure_cycles", lambda configs: {})
+    monkeypatch.setattr(sc, "section", lambda res, cycles: "")
+    monkeypatch.setattr(sc.synth, "versions", lambda: {})
+    for flag, want in (([], False), (["--mul3"], True)):
+        got.clear()
+        out = tmp_path / "r.json"
+        assert sc.main(["--configs", "default", "--engines", "--json", str(out), "--out", ""] + flag) == 0
+        assert got == {"run": want, "engines": want}
+        assert json.loads(out.read_text())["default"]["mul3"] is want
+    note = sc.mul3_note({"default": {"mul3": True}, "compact": {"mul3": False}})
+    assert note.startswith(" default: ") and "`--mul3`" in note and "compact" not in note
+    assert sc.mul3_note({"default": {"mul3": False}}) == ""
 
 
 def test_router_settings_and_cong_mult_checks(capsys):

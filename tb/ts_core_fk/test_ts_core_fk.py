@@ -280,10 +280,12 @@ if cocotb is not None:
 def test_ts_core_fk(cfg, sim):
     target = tsbench.target_for(sim)
     # FOLD: the servo core's (7) on Verilator, fully parallel (1) on Icarus: the bits must not change;
-    # the default configuration's folded run holds its banks' operands in shift chains (CHAIN 1)
+    # the default configuration's folded run holds its banks' operands in shift chains (CHAIN 1) and
+    # takes its wide ECP5 products on three MULT18X18D each (MUL3 1; the primitives' benches run MUL3 0)
+    variant = sim == "verilator" and cfg == "default"
     p = {"NMAX": NMAX, "CONFIG": 0 if cfg == "default" else 1, "ROM_FILE": str(rtlparams.rom_file(cfg)),
          "TARGET": target, "FOLD": 7 if sim == "verilator" else 1,
-         "CHAIN": 1 if (sim == "verilator" and cfg == "default") else 0}
+         "CHAIN": 1 if variant else 0, "MUL3": 1 if variant else 0}
     nq = os.environ.get("TS_NQ", "12" if sim == "verilator" else "3")
     tsbench.run_bench(toplevel=MODULE, test_file=__file__, sources=rtlparams.sources(MODULE, target),
                       parameters=p, sim=sim, build_name=f"{cfg}-{target}-{sim}",
