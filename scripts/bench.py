@@ -137,33 +137,51 @@ CORE_SWEEPS = 2
 CORE_GOAL_NS = 1000.0
 
 
-def core_fmax() -> dict:
-    """Post-route Fmax of the whole core per configuration from scripts/synth_core.py's results
-    (build/synth/core_results.json): {cfg: (MHz worst seed, device) or None}."""
+CORE_RESULTS = ROOT / "build" / "synth" / "core_results.json"
+RESOURCES = ROOT / "docs" / "resources.md"
+#: a 6-joint tick line of docs/resources.md's generated core section (scripts/synth_core.py)
+TICK_LINE = re.compile(r"^6-joint tick: (\d+) ns per tick \((\d+) cycles at [\d.]+ MHz, (LFE5U-\d+F) -6"
+                       r"(, post-placement estimate)?[^)]*\), (\w+) configuration", re.M)
+#: docs/resources.md's generated core section, and the date of its run
+SECTION = re.compile(r"<!-- BEGIN GENERATED core\b.*?-->(.*?)<!-- END GENERATED core -->", re.S)
+SECTION_RUN = re.compile(r", run (\d{4}-\d\d-\d\d)\.")
+
+
+def core_fmax(results: Path = CORE_RESULTS, resources: Path = RESOURCES) -> tuple[dict, str]:
+    """Fmax of the whole core per configuration, {cfg: (MHz, device text) or None}, and where it came
+    from.  The results of a scripts/synth_core.py run on this machine (`results`) come first; without
+    them (a fresh clone) the figures recorded in docs/resources.md's generated core section, whose
+    6-joint tick lines give the Fmax to the precision of their ns (cycles / ns)."""
     import json
 
-    f = ROOT / "build" / "synth" / "core_results.json"
-    res = json.loads(f.read_text()) if f.exists() else {}
-    out = {}
-    for cfg in ("default", "compact"):
-        r = res.get(cfg) or {}
-        if r.get("fmax"):
-            out[cfg] = (min(r["fmax"]), r["device"] + " -6")
-        elif r.get("fmax_placed"):     # routing did not finish: nextpnr's post-placement estimate
-            out[cfg] = (r["fmax_placed"], r["device"] + " -6, post-placement estimate")
-        else:
-            out[cfg] = None
-    return out
+    out: dict = {"default": None, "compact": None}
+    if results.exists():
+        res = json.loads(results.read_text())
+        for cfg in out:
+            r = res.get(cfg) or {}
+            if r.get("fmax"):
+                out[cfg] = (min(r["fmax"]), r["device"] + " -6")
+            elif r.get("fmax_placed"):     # routing did not finish: nextpnr's post-placement estimate
+                out[cfg] = (r["fmax_placed"], r["device"] + " -6, post-placement estimate")
+        where = results.relative_to(ROOT) if results.is_relative_to(ROOT) else results
+        return out, f"{where}, a `scripts/synth_core.py` run on this machine"
+    m = SECTION.search(resources.read_text()) if resources.exists() else None
+    section = m.group(1) if m else ""
+    for ns, cycles, dev, est, cfg in TICK_LINE.findall(section):
+        if cfg in out and int(ns) > 0:
+            out[cfg] = (int(cycles) / int(ns) * 1e3, dev + " -6" + (", post-placement estimate" if est else ""))
+    run = SECTION_RUN.search(section)
+    return out, f"docs/resources.md's generated core section{' (run ' + run.group(1) + ')' if run else ''}"
 
 
 def bench_core(seconds: float) -> str:
     """The servo core's tick (cycles measured on the Verilated core in this run, at the post-route
     Fmax of scripts/synth_core.py) against the same tick of the C++ model in double on one core."""
     exe = build_bench("bench_tick", pinocchio=False)
-    fmax = core_fmax()
+    fmax, source = core_fmax()
     lines = [f"Tick: FK, Jacobian, servo law (A, feed-forward), {CORE_SWEEPS} descent sweeps. Core: cycles per tick "
              "(TICK_CYCLES) of the Verilated core measured in this run, at the worst-seed post-route Fmax of the "
-             "whole core from `scripts/synth_core.py` (build/synth/core_results.json; not re-run by make bench), or "
+             f"whole core from `scripts/synth_core.py` ({source}; not re-run by make bench), or "
              "nextpnr's post-placement estimate where routing did not finish. "
              "Peer: `model/bench/bench_tick.cpp`, the model's `servo_tick` in double, -O3 -march=native, one core, "
              "min / median ns over 7 repetitions.", "",
