@@ -274,18 +274,19 @@ def test_no_widelut_reaches_every_synth_ecp5(tmp_path):
     assert sc.widelut_note({"compact": {"widelut": True}}) == ""
 
 
-def test_no_widelut_reaches_the_engine_runs(tmp_path, monkeypatch):
-    """main: --no-widelut is handed to the whole core's run and to the --engines runs alike (the
-    syntheses and nextpnr replaced by recorders)."""
+def record_main_runs(monkeypatch, arg):
+    """Replace synth_core's whole-core run and engine runs (and the cycle count, the doc section
+    and the tool versions) by recorders; the dict returned gets, under "run" and "engines", the
+    argument named `arg` each was called with."""
     sc = synth_core
     got = {}
 
     def fake_run(cfg, seeds, pnr, router, place_on, below, minutes, widelut, cong_mult, router2, params):
-        got["run"] = widelut
+        got["run"] = locals()[arg]
         return {}
 
     def fake_engines(cfg, opt, seed, jobs, router, widelut=True, params=None):
-        got["engines"] = widelut
+        got["engines"] = locals()[arg]
         return {}
 
     monkeypatch.setattr(sc, "run", fake_run)
@@ -293,6 +294,14 @@ def test_no_widelut_reaches_the_engine_runs(tmp_path, monkeypatch):
     monkeypatch.setattr(sc, "measure_cycles", lambda configs: {})
     monkeypatch.setattr(sc, "section", lambda res, cycles: "")
     monkeypatch.setattr(sc.synth, "versions", lambda: {})
+    return got
+
+
+def test_no_widelut_reaches_the_engine_runs(tmp_path, monkeypatch):
+    """main: --no-widelut is handed to the whole core's run and to the --engines runs alike (the
+    syntheses and nextpnr replaced by recorders)."""
+    sc = synth_core
+    got = record_main_runs(monkeypatch, "widelut")
     for flag, want in (([], True), (["--no-widelut"], False)):
         got.clear()
         assert sc.main(["--configs", "compact", "--engines", "--json", str(tmp_path / "r.json"), "--out", ""]
@@ -320,21 +329,7 @@ def test_core_param_reaches_every_core_synthesis(tmp_path, monkeypatch, flag, na
             ch = [ln for ln in t.splitlines() if ln.startswith("chparam") and ln.endswith(" ts_servo_core")]
             assert len(ch) == 1 and (f"-set {name} 1 " in ch[0]) == on, ch
             assert f"-set {other} 1 " not in ch[0], ch
-    got = {}
-
-    def fake_run(cfg, seeds, pnr, router, place_on, below, minutes, widelut, cong_mult, router2, params):
-        got["run"] = params
-        return {}
-
-    def fake_engines(cfg, opt, seed, jobs, router, widelut=True, params=None):
-        got["engines"] = params
-        return {}
-
-    monkeypatch.setattr(sc, "run", fake_run)
-    monkeypatch.setattr(sc, "run_engines", fake_engines)
-    monkeypatch.setattr(sc, "measure_cycles", lambda configs: {})
-    monkeypatch.setattr(sc, "section", lambda res, cycles: "")
-    monkeypatch.setattr(sc.synth, "versions", lambda: {})
+    got = record_main_runs(monkeypatch, "params")
     for argv, want in (([], {}), ([f"--{flag}"], {name: 1}), (["--mul3", "--chain"], {"MUL3": 1, "CHAIN": 1})):
         got.clear()
         out = tmp_path / "r.json"
