@@ -166,6 +166,7 @@ module ts_core_fk #(
 
   genvar gi;
   integer k;
+  integer kc;  // loop index of the configuration block (one loop variable per process: no shared register)
 
   // ---- configuration ---------------------------------------------------------------------------
   // Per joint: memories without reset (ts_ram, one per vector component; distributed RAM on ECP5),
@@ -232,11 +233,11 @@ module ts_core_fk #(
   // base, tool, joint count
   always @(posedge clk) begin
     if (rst) begin
-      for (k = 0; k < 4; k = k + 1) begin
-        c_qb[k] <= {Q_W{1'b0}};
-        c_pb[k] <= {LN_W{1'b0}};
-        c_qt[k] <= {Q_W{1'b0}};
-        c_pt[k] <= {LN_W{1'b0}};
+      for (kc = 0; kc < 4; kc = kc + 1) begin
+        c_qb[kc] <= {Q_W{1'b0}};
+        c_pb[kc] <= {LN_W{1'b0}};
+        c_qt[kc] <= {Q_W{1'b0}};
+        c_pt[kc] <= {LN_W{1'b0}};
       end
       c_n <= {(JI_W+1){1'b0}};
     end else if (cfg_wr && cg) begin

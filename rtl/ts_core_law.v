@@ -175,6 +175,7 @@ module ts_core_law #(
 
   genvar gi;
   integer k;
+  integer ki;  // loop index of the input registers (one loop variable per process: no shared register)
 
   // ---- inputs, registered at the start edge -------------------------------------------------------
   wire start = in_start && !out_busy;
@@ -192,15 +193,15 @@ module ts_core_law #(
       r_ff <= 1'b0;
       r_kp <= {G_W{1'b0}};
       r_ko <= {G_W{1'b0}};
-      for (k = 0; k < 4; k = k + 1) begin
-        tq[k] <= {Q_W{1'b0}};
-        uq[k] <= {Q_W{1'b0}};
+      for (ki = 0; ki < 4; ki = ki + 1) begin
+        tq[ki] <= {Q_W{1'b0}};
+        uq[ki] <= {Q_W{1'b0}};
       end
-      for (k = 0; k < 3; k = k + 1) begin
-        tp[k] <= {P_W{1'b0}};
-        up[k] <= {P_W{1'b0}};
-        uw[k] <= {V_W{1'b0}};
-        uv[k] <= {V_W{1'b0}};
+      for (ki = 0; ki < 3; ki = ki + 1) begin
+        tp[ki] <= {P_W{1'b0}};
+        up[ki] <= {P_W{1'b0}};
+        uw[ki] <= {V_W{1'b0}};
+        uv[ki] <= {V_W{1'b0}};
       end
     end else if (start) begin
       r_mb <= in_mode_b;

@@ -89,6 +89,7 @@ module ts_quat_rotate #(
 
   reg signed [PA_W:0] da [0:2];
   integer k;
+  integer ks;  // loop index of the sum stage (one loop variable per process: no shared register)
   always @(posedge clk) begin
     if (rst) begin
       for (k = 0; k < 3; k = k + 1) da[k] <= {(PA_W+1){1'b0}};
@@ -170,17 +171,17 @@ module ts_quat_rotate #(
   reg signed [S_W-1:0] s2 [0:2];
   always @(posedge clk) begin
     if (rst) begin
-      for (k = 0; k < 3; k = k + 1) begin
-        s1[k] <= {S_W{1'b0}};
-        c1[k] <= {S_W{1'b0}};
-        s2[k] <= {S_W{1'b0}};
+      for (ks = 0; ks < 3; ks = ks + 1) begin
+        s1[ks] <= {S_W{1'b0}};
+        c1[ks] <= {S_W{1'b0}};
+        s2[ks] <= {S_W{1'b0}};
       end
     end else begin
-      for (k = 0; k < 3; k = k + 1) begin
-        s1[k] <= va[k] + wa[k];
-        if (INV == 0) c1[k] <= pe[2*k] - pe[2*k+1];
-        else          c1[k] <= pe[2*k+1] - pe[2*k];
-        s2[k] <= s1[k] + c1[k];
+      for (ks = 0; ks < 3; ks = ks + 1) begin
+        s1[ks] <= va[ks] + wa[ks];
+        if (INV == 0) c1[ks] <= pe[2*ks] - pe[2*ks+1];
+        else          c1[ks] <= pe[2*ks+1] - pe[2*ks];
+        s2[ks] <= s1[ks] + c1[ks];
       end
     end
   end

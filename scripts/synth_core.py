@@ -77,8 +77,7 @@ def yosys_read_lines(cfg: str, params: dict[str, int] | None = None) -> list[str
     files = " ".join(str(Path(f).relative_to(ROOT)) for f in rtlparams.sources("ts_servo_core", "ECP5", sim_models=False))
     sets = " ".join(f'-set {k} "{Path(v).relative_to(ROOT) if str(v).startswith(str(ROOT)) else v}"' if isinstance(v, str)
                     else f"-set {k} {v}" for k, v in params.items())
-    return ["read_verilog -lib +/ecp5/cells_bb.v", f"read_verilog -Irtl {files}", f"chparam {sets} ts_servo_core",
-            "hierarchy -top ts_servo_core"]
+    return synth.elaborate_lines("ts_servo_core", files, sets, ecp5=True)
 
 
 def synth_flags(widelut: bool) -> str:

