@@ -198,46 +198,69 @@ def parse_hier_stat(path: Path) -> dict[str, dict[str, int]]:
     return out
 
 
-def engine_totals(path: Path, own: dict[str, dict[str, int]]) -> dict[str, dict[str, int]]:
-    """Cells of each direct child of the top with everything below it (the 'design hierarchy'
-    tree of `stat`: per line a module and its number of instances in its parent), summed by the
-    child's module name (ts_core_fk, ts_sel, ...)."""
-    lines = (ROOT / path).read_text().split("=== design hierarchy ===", 1)[1].splitlines()
-    rows = []
-    for ln in lines:
-        m = re.match(r"^( +)(\S+)\s+(\d+)\s*$", ln)
+def parse_modules(path: Path) -> dict[str, tuple[dict[str, int], dict[str, int]]]:
+    """{module: (its own cells by type, its submodule instances by module)} from the per-module
+    sections of a hierarchical `stat`, in the formats of yosys 0.23 ("<type> <count>", submodules
+    among the cell types) and 0.70 ("<count> <type>", submodules under their own heading) alike.
+    A cell type is a submodule when the file has a section of that name."""
+    sections: dict[str, list[tuple[str, int]]] = {}
+    cur = None
+    for line in (ROOT / path).read_text().splitlines():
+        m = re.match(r"^=== (.+) ===$", line.strip())
         if m:
-            rows.append((len(m.group(1)), m.group(2), int(m.group(3))))
-        elif rows and ln.strip() and not ln.startswith(" "):
-            break
+            cur = None if m.group(1) == "design hierarchy" else m.group(1)
+            if cur is not None:
+                sections[cur] = []
+            continue
+        m = re.match(r"^\s+(\d+)\s+(\S+)\s*$", line) or re.match(r"^\s+(\S+)\s+(\d+)\s*$", line)
+        if cur is not None and m:
+            a, b = m.groups()
+            name, n = (b, int(a)) if a.isdigit() else (a, int(b))
+            sections[cur].append((name, n))
+    out = {}
+    for mod, rows in sections.items():
+        own: dict[str, int] = {}
+        sub: dict[str, int] = {}
+        for name, n in rows:
+            if name in sections:
+                sub[name] = sub.get(name, 0) + n
+            elif not name.startswith("$") and name not in ("wires", "cells", "ports", "processes", "memories",
+                                                               "submodules"):
+                own[name] = own.get(name, 0) + n
+        out[mod] = (own, sub)
+    return out
 
-    def subtree(i: int) -> tuple[dict[str, int], int]:
-        depth, name, _ = rows[i]
-        tot = dict(counts(own.get(name, {})))
-        j = i + 1
-        while j < len(rows) and rows[j][0] > depth:
-            sub, nxt = subtree(j)
-            for k in tot:
-                tot[k] += rows[j][2] * sub[k]
-            j = nxt
-        return tot, j
+
+def engine_totals(path: Path) -> dict[str, dict[str, int]]:
+    """Cells of each direct child of the top with everything below it, summed by the child's
+    module name (ts_core_fk, ts_sel, ...), and the top's own logic; from the per-module sections of
+    a hierarchical `stat` (parse_modules: yosys 0.23 and 0.70)."""
+    mods = parse_modules(path)
+    if not mods:
+        return {}
+    children = {c for _, sub in mods.values() for c in sub}
+    tops = [m for m in mods if m not in children]
+    if len(tops) != 1:
+        raise RuntimeError(f"{path}: {len(tops)} top modules in the hierarchical stat, expected 1")
+    memo: dict[str, dict[str, int]] = {}
+
+    def subtree(mod: str) -> dict[str, int]:
+        if mod not in memo:
+            own, sub = mods[mod]
+            tot = dict(counts(own))
+            for c, n in sub.items():
+                for k, v in subtree(c).items():
+                    tot[k] += n * v
+            memo[mod] = tot
+        return memo[mod]
 
     out: dict[str, dict[str, int]] = {}
-    if not rows:
-        return out
-    j = 1
-    while j < len(rows) and rows[j][0] > rows[0][0]:
-        sub, nxt = subtree(j)
-        name = rows[j][1].split("\\")[-1]
-        if re.fullmatch(r"[A-Z0-9_]+", name):     # a cell type listed under the top, not a module
-            j = nxt
-            continue
-        acc = out.setdefault(name, {k: 0 for k in sub})
-        for k in sub:
-            acc[k] += rows[j][2] * sub[k]
-        j = nxt
-    top_own = counts(own.get(rows[0][1], {}))
-    out["(top's own logic)"] = top_own
+    own, sub = mods[tops[0]]
+    for c, n in sub.items():
+        acc = out.setdefault(c.split("\\")[-1], {k: 0 for k in counts({})})
+        for k, v in subtree(c).items():
+            acc[k] += n * v
+    out["(top's own logic)"] = counts(own)
     return out
 
 
@@ -254,7 +277,7 @@ def stat_results(stat: Path, flat_stat: Path) -> dict:
     tot = counts(flat.get("total") or flat["ts_servo_core"])     # one module: no hierarchy section
     fits = [(dev, not over(tot, dev)) for _, dev, *_ in DEVICES]
     return {"total": tot, "total_hier": counts(hs.get("total", {})),
-            "engines": engine_totals(stat, {k: v for k, v in hs.items() if k != "total"}), "fits": fits}
+            "engines": engine_totals(stat), "fits": fits}
 
 
 def use(tot: dict[str, int], dev: str) -> list[tuple[str, int, int]]:

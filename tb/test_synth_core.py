@@ -504,3 +504,115 @@ def test_elaboration_lines_synthesise_on_both_yosys(exe_name):
         p = run([ln for ln in lines if ln != fix], "without")
         log = (ROOT / d / "without.log").read_text()
         assert p.returncode != 0 and "is not part of the design" in log, log[-2000:]
+
+
+#: a hierarchical `stat` of yosys 0.23, written for the test: top with three LUT4 of its own, two
+#: instances of a derived ts_sel (4 LUT4, 2 FF and one ts_leaf each) and one ts_leaf (1 MULT18X18D)
+STAT_023 = """
+=== top ===
+
+   Number of wires:                 10
+   Number of wire bits:             40
+   Number of cells:                  6
+     $paramod$abc\\ts_sel             2
+     LUT4                            3
+     ts_leaf                         1
+
+=== $paramod$abc\\ts_sel ===
+
+   Number of wires:                  4
+   Number of cells:                  7
+     LUT4                            4
+     TRELLIS_FF                      2
+     ts_leaf                         1
+
+=== ts_leaf ===
+
+   Number of cells:                  1
+     MULT18X18D                      1
+
+=== design hierarchy ===
+
+   top                               1
+     $paramod$abc\\ts_sel             2
+       ts_leaf                       1
+     ts_leaf                         1
+
+   Number of cells:                 17
+     LUT4                           11
+     MULT18X18D                      3
+     TRELLIS_FF                      4
+"""
+
+#: the same design in yosys 0.70's format (counts first, submodules under their own heading, the
+#: hierarchy tree with counts including submodules)
+STAT_070 = """
+=== top ===
+
+        +----------Local Count, excluding submodules.
+        | 
+       10 wires
+       40 wire bits
+        6 cells
+        3   LUT4
+        3 submodules
+        2   $paramod$abc\\ts_sel
+        1   ts_leaf
+
+=== $paramod$abc\\ts_sel ===
+
+        +----------Local Count, excluding submodules.
+        | 
+        4 wires
+        7 cells
+        4   LUT4
+        2   TRELLIS_FF
+        1 submodules
+        1   ts_leaf
+
+=== ts_leaf ===
+
+        +----------Local Count, excluding submodules.
+        | 
+        1 cells
+        1   MULT18X18D
+
+=== design hierarchy ===
+
+        +----------Count including submodules.
+        | 
+       17 top
+        7   $paramod$abc\\ts_sel
+        1     ts_leaf
+        1   ts_leaf
+
+        +----------Count including submodules.
+        | 
+       17 cells
+       11   LUT4
+        3   MULT18X18D
+        4   TRELLIS_FF
+"""
+
+
+@pytest.mark.parametrize("text", [STAT_023, STAT_070], ids=["yosys-0.23", "yosys-0.70"])
+def test_engine_totals_reads_both_stat_formats(tmp_path, text):
+    """Per-engine counts (each child of the top with everything below it, times its instances) and
+    the top's own logic, the same from either yosys's hierarchical `stat`; the engines add up to
+    the design's total."""
+    f = tmp_path / "stat.txt"
+    f.write_text(text)
+    e = synth_core.engine_totals(f)
+    zero = {"LUT4": 0, "CCU2C": 0, "FF": 0, "MULT18X18D": 0, "EBR": 0, "DPR16X4": 0}
+    assert e == {"ts_sel": dict(zero, LUT4=8, FF=4, MULT18X18D=2), "ts_leaf": dict(zero, MULT18X18D=1),
+                 "(top's own logic)": dict(zero, LUT4=3)}
+    total = synth_core.counts(synth_core.parse_hier_stat(f)["total"])
+    assert {k: sum(v[k] for v in e.values()) for k in zero} == total
+
+
+def test_engine_totals_refuses_two_tops(tmp_path):
+    """Two modules that nothing instantiates: not a core's stat, an error naming the file."""
+    f = tmp_path / "stat.txt"
+    f.write_text(STAT_023.replace("=== design hierarchy ===", "=== other ===\n\n     LUT4  1\n\n=== design hierarchy ==="))
+    with pytest.raises(RuntimeError, match="2 top modules"):
+        synth_core.engine_totals(f)
