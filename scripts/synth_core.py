@@ -176,58 +176,57 @@ def yosys_flat_lut_resets(exe: str, read_lines: list[str], top: str, d: Path, ou
     return n_ff, n_net
 
 
-def parse_hier_stat(path: Path) -> dict[str, dict[str, int]]:
-    """Per-module cell counts of a hierarchical `stat` (sections '=== name ==='), plus 'total'
-    (the 'design hierarchy' section)."""
-    out: dict[str, dict[str, int]] = {}
+#: `stat` lines that count something other than cells (yosys 0.23 and 0.70)
+STAT_LABELS = ("wires", "cells", "ports", "processes", "memories", "submodules")
+
+
+def stat_sections(path: Path) -> dict[str, list[tuple[str, int]]]:
+    """{section: [(name, count), ...]} of a `stat` report (sections '=== name ==='; the 'design
+    hierarchy' one as 'total'), each line "<name> <count>" (yosys 0.23) or "<count> <name>" (0.70)."""
+    out: dict[str, list[tuple[str, int]]] = {}
     cur = None
     for line in (ROOT / path).read_text().splitlines():
         m = re.match(r"^=== (.+) ===$", line.strip())
         if m:
             cur = "total" if m.group(1) == "design hierarchy" else m.group(1)
-            out[cur] = {}
-            continue
-        if cur is None:
-            continue
-        m = re.match(r"^\s+([A-Za-z_][\w$]*)\s+(\d+)\s*$", line) or re.match(r"^\s+(\d+)\s+([A-Za-z_][\w$]*)\s*$", line)
-        if m:
-            a, b = m.groups()
-            name, n = (a, int(b)) if not a.isdigit() else (b, int(a))
-            if not name.startswith("$") and name not in ("wires", "cells", "ports", "processes", "memories"):
-                out[cur][name] = out[cur].get(name, 0) + n
-    return out
-
-
-def parse_modules(path: Path) -> dict[str, tuple[dict[str, int], dict[str, int]]]:
-    """{module: (its own cells by type, its submodule instances by module)} from the per-module
-    sections of a hierarchical `stat`, in the formats of yosys 0.23 ("<type> <count>", submodules
-    among the cell types) and 0.70 ("<count> <type>", submodules under their own heading) alike.
-    A cell type is a submodule when the file has a section of that name."""
-    sections: dict[str, list[tuple[str, int]]] = {}
-    cur = None
-    for line in (ROOT / path).read_text().splitlines():
-        m = re.match(r"^=== (.+) ===$", line.strip())
-        if m:
-            cur = None if m.group(1) == "design hierarchy" else m.group(1)
-            if cur is not None:
-                sections[cur] = []
+            out[cur] = []
             continue
         m = re.match(r"^\s+(\d+)\s+(\S+)\s*$", line) or re.match(r"^\s+(\S+)\s+(\d+)\s*$", line)
         if cur is not None and m:
             a, b = m.groups()
-            name, n = (b, int(a)) if a.isdigit() else (a, int(b))
-            sections[cur].append((name, n))
+            out[cur].append((b, int(a)) if a.isdigit() else (a, int(b)))
+    return out
+
+
+def cell_counts(rows: list[tuple[str, int]], modules=()) -> dict[str, int]:
+    """Cells by type of one `stat` section, without the other counts, yosys's internal types
+    ($...) and the instances of `modules`."""
+    out: dict[str, int] = {}
+    for name, n in rows:
+        if not name.startswith("$") and name not in STAT_LABELS and name not in modules:
+            out[name] = out.get(name, 0) + n
+    return out
+
+
+def parse_hier_stat(path: Path) -> dict[str, dict[str, int]]:
+    """Per-module cell counts of a hierarchical `stat`, plus 'total' (the 'design hierarchy'
+    section)."""
+    return {name: cell_counts(rows) for name, rows in stat_sections(path).items()}
+
+
+def parse_modules(path: Path) -> dict[str, tuple[dict[str, int], dict[str, int]]]:
+    """{module: (its own cells by type, its submodule instances by module)} from the per-module
+    sections of a hierarchical `stat`, in the formats of yosys 0.23 (submodules among the cell
+    types) and 0.70 (submodules under their own heading) alike. A cell type is a submodule when the
+    file has a section of that name."""
+    sections = {k: v for k, v in stat_sections(path).items() if k != "total"}
     out = {}
     for mod, rows in sections.items():
-        own: dict[str, int] = {}
         sub: dict[str, int] = {}
         for name, n in rows:
             if name in sections:
                 sub[name] = sub.get(name, 0) + n
-            elif not name.startswith("$") and name not in ("wires", "cells", "ports", "processes", "memories",
-                                                               "submodules"):
-                own[name] = own.get(name, 0) + n
-        out[mod] = (own, sub)
+        out[mod] = (cell_counts(rows, sections), sub)
     return out
 
 
