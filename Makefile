@@ -5,8 +5,8 @@
 #   make bench   benchmark tables (docs/benchmarks.md)
 #   make golden  regenerate tb/golden/ from the model
 #   make synth   ECP5 / 7-series resources and post-route Fmax of the RTL (docs/resources.md)
-#   make synth-core  the whole servo core placed and routed on LFE5U-85F, both configurations
-#                (about 1.5 h: each routing is stopped after ROUTE_MINUTES, default 60)
+#   make synth-core  the whole servo core placed and routed, default on LFE5U-85F, compact on LFE5U-45F
+#                (over an hour: each routing is stopped after ROUTE_MINUTES, default 50)
 #   make lint    verilator -Wall and iverilog on every RTL parameter set; HLS kernel checks
 #   make soak    the Verilated core against the model, 10,000 ticks per chain and configuration
 SHELL := /bin/bash
@@ -127,17 +127,20 @@ lint: setup hls-lint lint-rtl
 lint-rtl: setup
 	PYTHON=$(PY) bash scripts/lint_rtl.sh -j $(JOBS)
 
-# Yosys synth_ecp5 + nextpnr-ecp5 (LFE5U-85F -6, 3 seeds) and synth_xilinx counts; ~10 min on 2 cores.
+# Yosys synth_ecp5 + nextpnr-ecp5 (LFE5U-85F -6, 3 seeds) and synth_xilinx counts; about an hour on 2
+# cores (54 min for the run recorded in docs/resources.md, 2026-11-22).
 synth: setup
 	$(PY) scripts/synth.py --jobs $(JOBS)
 
-# The whole core (both configurations side by side, router2, on LFE5U-85F): counts of every engine,
-# post-route Fmax, cycles per tick -> the generated core section of docs/resources.md. A routing
-# still running after ROUTE_MINUTES (the default core's does not converge) is stopped and reported
-# with its last router2 iteration; ROUTE_MINUTES= (empty) lets it run.
-ROUTE_MINUTES ?= 60
+# The whole core (both configurations side by side, router2, each on the smallest ECP5 its counts
+# fit: default LFE5U-85F, compact LFE5U-45F; synth_ecp5 -nowidelut): counts of every engine,
+# post-route Fmax, cycles per tick -> the generated core section of docs/resources.md. The same
+# command as the recorded run there (tb/test_synth_core.py checks it). A routing still running
+# after ROUTE_MINUTES (the default core's does not converge) is stopped and reported with its last
+# router2 iteration; ROUTE_MINUTES= (empty) lets it run.
+ROUTE_MINUTES ?= 50
 synth-core: setup
-	$(PY) scripts/synth_core.py --place-on LFE5U-85F $(if $(ROUTE_MINUTES),--route-minutes $(ROUTE_MINUTES))
+	$(PY) scripts/synth_core.py --no-widelut $(if $(ROUTE_MINUTES),--route-minutes $(ROUTE_MINUTES))
 
 # ---- register map (rtl/ts_servo_regs.rdl -> Verilog, C header, Python, docs) -------------------------
 regs: setup

@@ -13,7 +13,7 @@ is reported with the count that does not fit; nothing is placed then.
     .venv/bin/python scripts/synth_core.py                    # both configurations -> docs/resources.md
     .venv/bin/python scripts/synth_core.py --configs compact --seeds 1
     .venv/bin/python scripts/synth_core.py --configs default --engines   # + each engine placed alone
-    .venv/bin/python scripts/synth_core.py --place-on LFE5U-85F --route-minutes 60   # make synth-core
+    .venv/bin/python scripts/synth_core.py --no-widelut --route-minutes 50     # make synth-core
     .venv/bin/python scripts/synth_core.py --configs compact --place-on LFE5U-45F --lut-resets-below 5
 
 The configurations run side by side. router2 is the default router: it routed the whole compact
@@ -832,7 +832,8 @@ def write_doc(res: dict, cycles: dict, path: Path) -> None:
     path.write_text(text)
 
 
-def main(argv: list[str] | None = None) -> int:
+def build_parser() -> argparse.ArgumentParser:
+    """The command line (main's, and the test that `make synth-core` repeats the recorded run)."""
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--configs", nargs="+", default=["compact", "default"], choices=["compact", "default"])
     ap.add_argument("--seeds", nargs="+", type=int, default=[1])
@@ -871,6 +872,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", default=str(WORK / "core_results.json"), help="results (JSON) for docs/resources.md")
     ap.add_argument("--doc-only", action="store_true", help="rewrite the doc section from --json, no synthesis")
     ap.add_argument("--out", default="docs/resources.md", help="markdown to patch ('' = none)")
+    return ap
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = build_parser()
     a = ap.parse_args(argv)
     params = core_params(**{k: getattr(a, k) for k in CORE_PARAM_FLAGS})
     if a.lut_resets_below < 0:

@@ -616,3 +616,30 @@ def test_engine_totals_refuses_two_tops(tmp_path):
     f.write_text(STAT_023.replace("=== design hierarchy ===", "=== other ===\n\n     LUT4  1\n\n=== design hierarchy ==="))
     with pytest.raises(RuntimeError, match="2 top modules"):
         synth_core.engine_totals(f)
+
+
+def _synth_core_args(command: str) -> dict:
+    """The options a synth_core.py command line sets (every option, defaults filled in by main's parser)."""
+    import shlex
+    words = shlex.split(command)
+    at = next(i for i, w in enumerate(words) if w.endswith("scripts/synth_core.py"))
+    return vars(synth_core.build_parser().parse_args(words[at + 1:]))
+
+
+def test_make_synth_core_repeats_the_recorded_run():
+    """`make synth-core` (the README's command for the core's figures) runs what made the generated
+    section of docs/resources.md: the same options, so a user who runs it reproduces the recorded
+    devices, netlist flags and routing limit (before 2026-12-07 it placed both configurations on
+    LFE5U-85F with wide LUTs, unlike the recorded run)."""
+    import os
+    import re
+    env = {k: v for k, v in os.environ.items() if k not in ("MAKEFLAGS", "MFLAGS", "MAKELEVEL", "ROUTE_MINUTES")}
+    out = subprocess.run(["make", "-n", "-o", "setup", "synth-core"], cwd=ROOT, env=env, capture_output=True,
+                         text=True, check=True).stdout
+    make_cmd = [ln for ln in out.splitlines() if "scripts/synth_core.py" in ln]
+    assert len(make_cmd) == 1, out
+    doc = (ROOT / "docs" / "resources.md").read_text()
+    section = doc[doc.index("<!-- BEGIN GENERATED core"):doc.index("<!-- END GENERATED core")]
+    recorded = re.search(r"; command `([^`]*scripts/synth_core\.py[^`]*)`", section)
+    assert recorded, "the generated core section names no synth_core.py command"
+    assert _synth_core_args(make_cmd[0]) == _synth_core_args(recorded.group(1))
