@@ -9,6 +9,10 @@
   tb/fusesoc/quat_mul_<config>.hex  the committed golden vectors of ts_quat_mul (tb/golden/
                                  prim_quat_mul_<config>.npz) packed one per line for the FuseSoC
                                  sim target's self-checking Verilog bench ($readmemh)
+  tb/fusesoc/core_puma560_<config>.hex  the script of the servo core's self-checking Verilog bench
+                                 (tb/fusesoc/tb_ts_servo_core_golden.v, the FuseSoC sim_core
+                                 targets): register writes, commit, a closed loop of PUMA 560 ticks
+                                 with the model's expected output words (core_script below)
   docs/rtl/<module>.md           the blocks between "BEGIN GENERATED formats" and "END GENERATED
                                  formats": formats, parameter values and latency per configuration
 
@@ -80,6 +84,86 @@ def golden_hex_text(cfg: str) -> str:
             v = (v << w) | (int(x) & mask)
         v = (v << 1) | (1 if st else 0)
         lines.append(format(v, f"0{digits}x"))
+    return "\n".join(lines) + "\n"
+
+
+# ---- the servo core's bench script ------------------------------------------------------------------
+#: operations of tb/fusesoc/tb_ts_servo_core_golden.v (its localparams OP_*): one line per operation,
+#: {op (4 bits), address (12), data (32)}.  WRITE: AXI4-Lite write, BRESP must be OKAY; WRITE_ERR:
+#: the same, BRESP must be SLVERR; READ: the word read must equal data; POLL: read until
+#: (word & data) == 0; HAS: (word & data) == data; SEND: one input stream word, TLAST = address bit 0;
+#: RECV: the next output word must equal data, its TLAST address bit 0; SHOW: read and print.
+CORE_OPS = {"END": 0, "WRITE": 1, "WRITE_ERR": 2, "READ": 3, "POLL": 4, "HAS": 5, "SEND": 6, "RECV": 7, "SHOW": 8}
+CORE_SCRIPT_LINES = 1024        # the bench's NOPS: the script is padded with END to fill its memory
+CORE_SCRIPT_TICKS = 16          # closed-loop ticks of the script (a COLD one and a malformed packet among them)
+STATUS_MALFORMED = 1 << 30      # output status bit: malformed input packet (docs/programmers_guide.md)
+
+
+def core_script(cfg: str) -> list[tuple[str, int, int]]:
+    """The bench script of one configuration, from the model alone: PUMA 560 (the demo's robot) at
+    2 sweeps, configured over the register map as a host would (``rtl_core.register_writes``), a
+    write to a joint block above NMAX (SLVERR), CTRL.COMMIT, then CORE_SCRIPT_TICKS ticks from the
+    demo's start (``make demo``: its q0 and its circle, with the exact twists as feed-forward)
+    whose plant is exact integration (each tick's q is the last q_next); tick 9 is COLD, a packet
+    one word short comes after tick 11; TICK_COUNT at the end."""
+    import numpy as np
+    from tensor_servo import _model, pathgen, regs, robots
+    from tensor_servo.bench_tracking import HOME
+    from tensor_servo.rtl_core import IN_COLD, NMAX_DEFAULT, register_writes
+    from tensor_servo.servo import Servo, pose_to_quat_pos
+    from tensor_servo.track import relative_poses
+
+    chain = robots.load("puma560")
+    n, dt = chain.n, 1e-3
+    servo = Servo(chain, cfg, dt=dt, sweeps=2)
+    raw = servo._s.config_raw()
+    res, model = _model.commit_raw(cfg, raw, NMAX_DEFAULT)
+    assert res["code"] == 0, res
+    ops = [("WRITE", a, v) for a, v in register_writes(raw, NMAX_DEFAULT)]
+    ops.append(("WRITE_ERR", regs.joint_addr(NMAX_DEFAULT, "SCALE"), 1))
+    ops += [("WRITE", regs.CTRL, regs.CTRL_COMMIT), ("POLL", regs.STATUS, regs.STATUS_CFG_BUSY),
+            ("HAS", regs.STATUS, regs.STATUS_CFG_OK), ("WRITE", regs.CTRL, regs.CTRL_RUN | regs.CTRL_CLEAR)]
+    q0 = HOME["puma560"]
+    T, V = pathgen.circle(relative_poses(chain, q0[None])[0], 0.05, 2.0, dt, CORE_SCRIPT_TICKS * dt,
+                          plane=((0, 1, 0), (0, 0, 1)), tilt=0.2, axis=(1.0, 1.0, 0.0))
+    q = warm = None
+    ticks = 0
+
+    def packet(words):
+        return [("SEND", len(words) == k + 1, w & 0xFFFFFFFF) for k, w in enumerate(words)]
+
+    def answer(words):
+        return [("RECV", len(words) == k + 1, w & 0xFFFFFFFF) for k, w in enumerate(words)]
+
+    for k in range(CORE_SCRIPT_TICKS):
+        uq, up = pose_to_quat_pos(T[k])
+        ir = servo._s.inputs_raw(q0, uq[None], up[None], V[k:k + 1, :3].copy(), V[k:k + 1, 3:].copy(), np.zeros(n))
+        if q is None:
+            q, warm = np.asarray(ir["q"], dtype=np.int64), np.zeros(n, dtype=np.int64)
+        cold = k == 9
+        sp = [np.asarray(ir[f], dtype=np.int64) for f in ("uq", "up", "uw", "uv")]
+        words = [IN_COLD if cold else 0, *q.tolist()] + [int(x) for a in sp for x in np.ravel(a)]
+        o = model.tick_raw(q, *sp, np.zeros(n, dtype=np.int64) if cold else warm)
+        ticks += 1
+        warm, q = np.asarray(o["qd_raw"], dtype=np.int64), np.asarray(o["q_next_raw"], dtype=np.int64)
+        out = warm.tolist() + q.tolist() + [int(x) for x in np.ravel(o["ep_raw"])] + \
+            [int(x) for x in np.ravel(o["eo_raw"])] + [int(o["flags"]), ticks]
+        ops += packet(words) + answer(out)
+        if k == 11:                      # one word short: answered with bit 30 only, no state change
+            ops += packet(words[:-1]) + answer([0] * (2 * n + 6) + [STATUS_MALFORMED, ticks])
+    ops += [("READ", regs.TICK_COUNT, ticks), ("SHOW", regs.TICK_CYCLES, 0), ("END", 0, 0)]
+    return [(op, int(a), int(v)) for op, a, v in ops]
+
+
+def core_script_text(cfg: str) -> str:
+    ops = core_script(cfg)
+    assert len(ops) <= CORE_SCRIPT_LINES, len(ops)
+    ops += [("END", 0, 0)] * (CORE_SCRIPT_LINES - len(ops))
+    lines = [f"// tensor-servo ts_servo_core bench script, configuration {cfg}, NMAX 8: generated by "
+             f"scripts/gen_rtl_data.py (core_script) from the model; do not edit.",
+             f"// {len(ops)} lines {{op (4 bits), address (12), data (32)}} (END to the end); ops "
+             + ", ".join(f"{k} {v}" for k, v in CORE_OPS.items())]
+    lines += [format((CORE_OPS[op] << 44) | ((a & 0xFFF) << 32) | (v & 0xFFFFFFFF), "012x") for op, a, v in ops]
     return "\n".join(lines) + "\n"
 
 
@@ -161,6 +245,7 @@ def files() -> dict[Path, str]:
         d[rtlparams.rom_file(cfg)] = rom_text(cfg)
         d[rtlparams.RTL / f"ts_cfg_{cfg}.vh"] = vh_text(cfg)
         d[ROOT / "tb" / "fusesoc" / f"quat_mul_{cfg}.hex"] = golden_hex_text(cfg)
+        d[ROOT / "tb" / "fusesoc" / f"core_puma560_{cfg}.hex"] = core_script_text(cfg)
     d.update(docs_files())
     return d
 
