@@ -126,19 +126,15 @@ def core_script(cfg: str) -> list[tuple[str, int, int]]:
     q0 = HOME["puma560"]
     T, V = pathgen.circle(relative_poses(chain, q0[None])[0], 0.05, 2.0, dt, CORE_SCRIPT_TICKS * dt,
                           plane=((0, 1, 0), (0, 0, 1)), tilt=0.2, axis=(1.0, 1.0, 0.0))
-    q = warm = None
     ticks = 0
 
-    def packet(words):
-        return [("SEND", len(words) == k + 1, w & 0xFFFFFFFF) for k, w in enumerate(words)]
-
-    def answer(words):
-        return [("RECV", len(words) == k + 1, w & 0xFFFFFFFF) for k, w in enumerate(words)]
+    def stream(op, words):               # one SEND or RECV per word, TLAST (address bit 0) on the last
+        return [(op, len(words) == k + 1, w & 0xFFFFFFFF) for k, w in enumerate(words)]
 
     for k in range(CORE_SCRIPT_TICKS):
         uq, up = pose_to_quat_pos(T[k])
         ir = servo._s.inputs_raw(q0, uq[None], up[None], V[k:k + 1, :3].copy(), V[k:k + 1, 3:].copy(), np.zeros(n))
-        if q is None:
+        if k == 0:                       # the plant starts at the quantised q0, at rest after the commit
             q, warm = np.asarray(ir["q"], dtype=np.int64), np.zeros(n, dtype=np.int64)
         cold = k == 9
         sp = [np.asarray(ir[f], dtype=np.int64) for f in ("uq", "up", "uw", "uv")]
@@ -148,9 +144,9 @@ def core_script(cfg: str) -> list[tuple[str, int, int]]:
         warm, q = np.asarray(o["qd_raw"], dtype=np.int64), np.asarray(o["q_next_raw"], dtype=np.int64)
         out = warm.tolist() + q.tolist() + [int(x) for x in np.ravel(o["ep_raw"])] + \
             [int(x) for x in np.ravel(o["eo_raw"])] + [int(o["flags"]), ticks]
-        ops += packet(words) + answer(out)
+        ops += stream("SEND", words) + stream("RECV", out)
         if k == 11:                      # one word short: answered with bit 30 only, no state change
-            ops += packet(words[:-1]) + answer([0] * (2 * n + 6) + [STATUS_MALFORMED, ticks])
+            ops += stream("SEND", words[:-1]) + stream("RECV", [0] * (2 * n + 6) + [STATUS_MALFORMED, ticks])
     ops += [("READ", regs.TICK_COUNT, ticks), ("SHOW", regs.TICK_CYCLES, 0), ("END", 0, 0)]
     return [(op, int(a), int(v)) for op, a, v in ops]
 
