@@ -639,7 +639,7 @@ def test_make_synth_core_repeats_the_recorded_run():
     make_cmd = [ln for ln in out.splitlines() if "scripts/synth_core.py" in ln]
     assert len(make_cmd) == 1, out
     doc = (ROOT / "docs" / "resources.md").read_text()
-    section = doc[doc.index("<!-- BEGIN GENERATED core"):doc.index("<!-- END GENERATED core")]
+    section = doc[doc.index(synth_core.synth.CORE_BEGIN):doc.index(synth_core.synth.CORE_END)]
     recorded = re.search(r"; command `([^`]*scripts/synth_core\.py[^`]*)`", section)
     assert recorded, "the generated core section names no synth_core.py command"
     assert _synth_core_args(make_cmd[0]) == _synth_core_args(recorded.group(1))
