@@ -142,9 +142,10 @@ RESOURCES = ROOT / "docs" / "resources.md"
 #: a 6-joint tick line of docs/resources.md's generated core section (scripts/synth_core.py)
 TICK_LINE = re.compile(r"^6-joint tick: (\d+) ns per tick \((\d+) cycles at [\d.]+ MHz, (LFE5U-\d+F) -6"
                        r"(, post-placement estimate)?[^)]*\), (\w+) configuration", re.M)
-#: docs/resources.md's generated core section, and the date of its run
+#: docs/resources.md's generated core section, the date of its run and the RTL it measured
+#: (synth_core.rtl_note; sections written before it have no RTL)
 SECTION = re.compile(r"<!-- BEGIN GENERATED core\b.*?-->(.*?)<!-- END GENERATED core -->", re.S)
-SECTION_RUN = re.compile(r", run (\d{4}-\d\d-\d\d)\.")
+SECTION_RUN = re.compile(r", run (\d{4}-\d\d-\d\d)(?:\.|, (RTL of commit [^.]+)\.)")
 
 
 def core_fmax(results: Path = CORE_RESULTS, resources: Path = RESOURCES) -> tuple[dict, str]:
@@ -171,7 +172,8 @@ def core_fmax(results: Path = CORE_RESULTS, resources: Path = RESOURCES) -> tupl
         if cfg in out and int(ns) > 0:
             out[cfg] = (int(cycles) / int(ns) * 1e3, dev + " -6" + (", post-placement estimate" if est else ""))
     run = SECTION_RUN.search(section)
-    return out, f"docs/resources.md's generated core section{' (run ' + run.group(1) + ')' if run else ''}"
+    when = "" if not run else f" (run {run.group(1)}" + (f", {run.group(2)})" if run.group(2) else ")")
+    return out, f"docs/resources.md's generated core section{when}"
 
 
 def bench_core(seconds: float) -> str:

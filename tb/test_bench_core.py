@@ -35,6 +35,24 @@ def test_fmax_from_the_recorded_section(tmp_path):
     assert source == "docs/resources.md's generated core section (run 2031-02-03)"
 
 
+def test_section_written_by_synth_core_is_read(tmp_path):
+    """bench reads what scripts/synth_core.py writes (its own section() text, not a copy): the
+    tick lines, the run's date and the RTL commit it names."""
+    import synth_core
+    total = {"LUT4": 1, "CCU2C": 0, "FF": 1, "MULT18X18D": 1, "EBR": 0, "DPR16X4": 0}
+    cfg = {"fits": [(1, False), (2, True), (3, True)], "engines": {}, "total": total, "fmax": [54.3],
+           "device": "LFE5U-45F", "rtl": "abc1234"}
+    res = {"compact": cfg, "_cmd": "x", "_date": "2031-02-03"}
+    cycles = {"compact": {6: {2: 1074, 10: 2658}, 7: {2: 1213, 10: 3061}}}
+    doc = tmp_path / "resources.md"
+    doc.write_text("# Resources\n" + synth_core.synth.CORE_BEGIN + "\n" + synth_core.section(res, cycles)
+                   + synth_core.synth.CORE_END + "\n")
+    fmax, source = bench.core_fmax(tmp_path / "none.json", doc)
+    assert fmax["default"] is None and fmax["compact"][1] == "LFE5U-45F -6"
+    assert abs(fmax["compact"][0] - 54.3) < 0.01
+    assert source == "docs/resources.md's generated core section (run 2031-02-03, RTL of commit abc1234)"
+
+
 def test_results_of_this_machine_come_first(tmp_path):
     doc = tmp_path / "resources.md"
     doc.write_text(SECTION)

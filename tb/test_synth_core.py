@@ -643,3 +643,45 @@ def test_make_synth_core_repeats_the_recorded_run():
     recorded = re.search(r"; command `([^`]*scripts/synth_core\.py[^`]*)`", section)
     assert recorded, "the generated core section names no synth_core.py command"
     assert _synth_core_args(make_cmd[0]) == _synth_core_args(recorded.group(1))
+
+
+def _git(repo: Path, *args: str) -> str:
+    return subprocess.run(["git", "-C", str(repo), "-c", "user.name=t", "-c", "user.email=t@t", *args],
+                          capture_output=True, text=True, check=True).stdout.strip()
+
+
+def test_rtl_revision_names_the_last_rtl_commit(tmp_path):
+    """The generated sections say which RTL they measured: the last commit that touched rtl/ (not
+    a later docs-only one), marked when rtl/ has uncommitted changes; outside git, no hash."""
+    import synth
+    assert synth.rtl_revision(tmp_path) == "not a git checkout"
+    _git(tmp_path, "init", "-q")
+    (tmp_path / "rtl").mkdir()
+    (tmp_path / "rtl" / "ts_x.v").write_text("module ts_x; endmodule\n")
+    _git(tmp_path, "add", ".")
+    _git(tmp_path, "commit", "-q", "-m", "rtl")
+    rtl_commit = _git(tmp_path, "log", "-1", "--format=%h")
+    (tmp_path / "notes.md").write_text("docs\n")
+    _git(tmp_path, "add", ".")
+    _git(tmp_path, "commit", "-q", "-m", "docs")
+    assert _git(tmp_path, "log", "-1", "--format=%h") != rtl_commit
+    assert synth.rtl_revision(tmp_path) == rtl_commit
+    (tmp_path / "rtl" / "ts_x.v").write_text("module ts_x; wire a; endmodule\n")
+    assert synth.rtl_revision(tmp_path) == rtl_commit + " with uncommitted changes in rtl/"
+
+
+def test_section_names_the_rtl_of_each_configuration():
+    """The core section's first paragraph names the RTL commit; configurations kept from an older
+    run (another commit, or none recorded) are named one by one."""
+    total = {"LUT4": 1, "CCU2C": 0, "FF": 1, "MULT18X18D": 1, "EBR": 0, "DPR16X4": 0}
+    cfg = {"fits": [(1, False), (2, True), (3, True)], "engines": {}, "total": total, "fmax": [54.3],
+           "device": "LFE5U-45F"}
+    cycles = {c: {6: {2: 1074, 10: 2658}, 7: {2: 1213, 10: 3061}} for c in ("default", "compact")}
+    same = {"default": {**cfg, "rtl": "abc1234"}, "compact": {**cfg, "rtl": "abc1234"}, "_cmd": "x", "_date": "d"}
+    first = synth_core.section(same, cycles).split("\n")[2]
+    assert "run d, RTL of commit abc1234. " in first
+    mixed = {**same, "compact": {**cfg, "rtl": "def5678"}}
+    assert "RTL of commit abc1234 (default), def5678 (compact). " in synth_core.section(mixed, cycles)
+    old = {**same, "default": cfg}
+    assert "RTL of commit not recorded (default), abc1234 (compact). " in synth_core.section(old, cycles)
+    assert "RTL of commit not recorded. " in synth_core.section({"compact": cfg, "_cmd": "x", "_date": "d"}, cycles)
