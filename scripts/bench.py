@@ -172,7 +172,7 @@ def core_fmax(results: Path = CORE_RESULTS, resources: Path = RESOURCES) -> tupl
         if cfg in out and int(ns) > 0:
             out[cfg] = (int(cycles) / int(ns) * 1e3, dev + " -6" + (", post-placement estimate" if est else ""))
     run = SECTION_RUN.search(section)
-    when = "" if not run else f" (run {run.group(1)}" + (f", {run.group(2)})" if run.group(2) else ")")
+    when = f" (run {run.group(1)}{', ' + run.group(2) if run.group(2) else ''})" if run else ""
     return out, f"docs/resources.md's generated core section{when}"
 
 

@@ -19,14 +19,19 @@ import pytest
 
 import rtlparams
 
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "scripts"))
+from gen_rtl_data import CORE_OPS  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[1]
 VLNV = "tensor-servo:servo:tensor-servo"
 FUSESOC = str(Path(sys.executable).parent / "fusesoc")
 
 
-def fusesoc(target: str, build_root: Path) -> subprocess.CompletedProcess:
+def fusesoc(target: str, build_root: Path, tool: str | None = None) -> subprocess.CompletedProcess:
+    """`fusesoc run` of one target of the package (tool: the target's own when None)."""
     return subprocess.run([FUSESOC, "--cores-root", str(ROOT), "run", "--build-root", str(build_root),
-                           "--target", target, VLNV], cwd=ROOT, capture_output=True, text=True, timeout=900)
+                           "--target", target, *(["--tool", tool] if tool else []), VLNV],
+                          cwd=ROOT, capture_output=True, text=True, timeout=900)
 
 
 @pytest.mark.parametrize("target", ["lint", "lint_core", "lint_regs"])
@@ -85,8 +90,7 @@ CORE_PASS = r"PASS \d+ operations, 17 output packets \(340 words\) equal to the 
 @pytest.mark.parametrize("target,config,tool", [("sim_core", 0, "icarus"), ("sim_core_compact", 1, "icarus"),
                                                 ("sim_core_compact", 1, "verilator")])
 def test_sim_core_targets_match_the_model(target, config, tool, tmp_path):
-    p = subprocess.run([FUSESOC, "--cores-root", str(ROOT), "run", "--build-root", str(tmp_path), "--target",
-                        target, "--tool", tool, VLNV], cwd=ROOT, capture_output=True, text=True, timeout=900)
+    p = fusesoc(target, tmp_path, tool)
     out = p.stdout + p.stderr
     assert p.returncode == 0, out[-3000:]
     assert re.search(CORE_PASS.format(c=config), out), out[-3000:]
@@ -97,13 +101,14 @@ def _corrupt_core_script(kind: str) -> tuple[list[str], int]:
     output word, 'bresp' expects OKAY from the write the core must refuse. -> lines, the op index."""
     src = (ROOT / "tb" / "fusesoc" / "core_puma560_compact.hex").read_text().splitlines()
     ops = [i for i, line in enumerate(src) if not line.startswith("//")]
+    op = {name: format(code, "x") for name, code in CORE_OPS.items()}      # a line's first hex digit
     if kind == "word":
-        recv = [i for i in ops if src[i][0] == "7"]
+        recv = [i for i in ops if src[i][0] == op["RECV"]]
         k = recv[29]
         src[k] = src[k][:-1] + format(int(src[k][-1], 16) ^ 0x8, "x")
     else:
-        k = next(i for i in ops if src[i][0] == "2")
-        src[k] = "1" + src[k][1:]
+        k = next(i for i in ops if src[i][0] == op["WRITE_ERR"])
+        src[k] = op["WRITE"] + src[k][1:]
     return src, ops.index(k)
 
 
