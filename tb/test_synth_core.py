@@ -90,6 +90,34 @@ def test_nextpnr_cmd_router():
         raise AssertionError("router3 accepted")
 
 
+def test_router2_alt_weights_reach_nextpnr_and_the_section(capsys):
+    """--router2-alt-weights: nextpnr's flag on router2's command line only when asked; router1 is
+    refused (one line, no traceback, before anything runs); the section names the configurations
+    that used it and no others."""
+    sc = synth_core
+    plain = sc.nextpnr_cmd("--85k", Path("a.json"), 1, Path("a.log"), "router2")
+    alt = sc.nextpnr_cmd("--85k", Path("a.json"), 1, Path("a.log"), "router2", alt_weights=True)
+    assert "--router2-alt-weights" not in plain and alt == plain + ["--router2-alt-weights"]
+    try:
+        sc.nextpnr_cmd("--85k", Path("a.json"), 1, Path("a.log"), "router1", alt_weights=True)
+    except ValueError as e:
+        assert "router1" in str(e)
+    else:
+        raise AssertionError("alt_weights accepted with router1")
+    try:
+        sc.main(["--router", "router1", "--router2-alt-weights", "--out", ""])
+    except SystemExit as e:
+        assert e.code == 2
+    else:
+        raise AssertionError("--router2-alt-weights accepted with router1")
+    err = capsys.readouterr().err
+    assert "--router2-alt-weights: only with --router router2, not router1" in err and "Traceback" not in err
+    res = {"default": {"router": "router2", "router2_alt_weights": True},
+           "compact": {"router": "router2", "router2_alt_weights": False}}
+    assert sc.routers(res) == "`--router router2`, `--router2-alt-weights` (default)"
+    assert "alt-weights" not in sc.routers({"compact": {"router": "router2"}})   # results from before the option
+
+
 def test_section_names_router_and_device():
     """The generated text says which router ran and where each configuration was placed; a core
     routed on a larger device than its goal's is not reported as placed on the goal's device."""
@@ -281,7 +309,8 @@ def record_main_runs(monkeypatch, arg):
     sc = synth_core
     got = {}
 
-    def fake_run(cfg, seeds, pnr, router, place_on, below, minutes, widelut, cong_mult, router2, params):
+    def fake_run(cfg, seeds, pnr, router, place_on, below, minutes, widelut, cong_mult, router2, params,
+                 alt_weights):
         got["run"] = locals()[arg]
         return {}
 
@@ -307,6 +336,19 @@ def test_no_widelut_reaches_the_engine_runs(tmp_path, monkeypatch):
         assert sc.main(["--configs", "compact", "--engines", "--json", str(tmp_path / "r.json"), "--out", ""]
                        + flag) == 0
         assert got == {"run": want, "engines": want}
+
+
+def test_router2_alt_weights_reach_the_run_and_the_results(tmp_path, monkeypatch):
+    """main: --router2-alt-weights is handed to the whole core's run and recorded per configuration
+    (the syntheses and nextpnr replaced by recorders)."""
+    import json
+    got = record_main_runs(monkeypatch, "alt_weights")
+    for flag, want in (([], False), (["--router2-alt-weights"], True)):
+        got.clear()
+        out = tmp_path / f"r{len(flag)}.json"
+        assert synth_core.main(["--configs", "default", "--json", str(out), "--out", ""] + flag) == 0
+        assert got == {"run": want}
+        assert json.loads(out.read_text())["default"]["router2_alt_weights"] is want
 
 
 @pytest.mark.parametrize("flag,name", [("mul3", "MUL3"), ("chain", "CHAIN")])
