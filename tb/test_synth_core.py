@@ -90,6 +90,19 @@ def test_nextpnr_cmd_router():
         raise AssertionError("router3 accepted")
 
 
+def assert_main_refuses(capsys, argv: list[str], why: str) -> None:
+    """synth_core.main(argv) stops with exit code 2 (argparse's error) and one line containing
+    `why` on stderr, no traceback."""
+    try:
+        synth_core.main(argv)
+    except SystemExit as e:
+        assert e.code == 2
+    else:
+        raise AssertionError(f"{argv} accepted")
+    err = capsys.readouterr().err
+    assert why in err and "Traceback" not in err
+
+
 def test_router2_alt_weights_reach_nextpnr_and_the_section(capsys):
     """--router2-alt-weights: nextpnr's flag on router2's command line only when asked; router1 is
     refused (one line, no traceback, before anything runs); the section names the configurations
@@ -104,14 +117,8 @@ def test_router2_alt_weights_reach_nextpnr_and_the_section(capsys):
         assert "router1" in str(e)
     else:
         raise AssertionError("alt_weights accepted with router1")
-    try:
-        sc.main(["--router", "router1", "--router2-alt-weights", "--out", ""])
-    except SystemExit as e:
-        assert e.code == 2
-    else:
-        raise AssertionError("--router2-alt-weights accepted with router1")
-    err = capsys.readouterr().err
-    assert "--router2-alt-weights: only with --router router2, not router1" in err and "Traceback" not in err
+    assert_main_refuses(capsys, ["--router", "router1", "--router2-alt-weights", "--out", ""],
+                        "--router2-alt-weights: only with --router router2, not router1")
     res = {"default": {"router": "router2", "router2_alt_weights": True},
            "compact": {"router": "router2", "router2_alt_weights": False}}
     assert sc.routers(res) == "`--router router2`, `--router2-alt-weights` (default)"
@@ -409,14 +416,7 @@ def test_router_settings_and_cong_mult_checks(capsys):
             assert "cong_mult" in str(e)
         else:
             raise AssertionError(f"cong_mult {bad} accepted")
-    try:
-        synth_core.main(["--cong-mult", "1", "--out", ""])
-    except SystemExit as e:
-        assert e.code == 2
-    else:
-        raise AssertionError("--cong-mult 1 accepted")
-    err = capsys.readouterr().err
-    assert "--cong-mult: 1 is outside (1, 4]" in err and "Traceback" not in err
+    assert_main_refuses(capsys, ["--cong-mult", "1", "--out", ""], "--cong-mult: 1 is outside (1, 4]")
 
 
 def test_router2_setting_parses_and_refuses(capsys):
@@ -445,14 +445,7 @@ def test_router2_setting_parses_and_refuses(capsys):
     for argv, why in ((["--router2-setting", "noSuch=1"], "--router2-setting: unknown router2 setting 'noSuch'"),
                       (["--router", "router1", "--router2-setting", "histCongWeight=2"],
                        "--router2-setting: only with --router router2, not router1")):
-        try:
-            sc.main(argv + ["--out", ""])
-        except SystemExit as e:
-            assert e.code == 2
-        else:
-            raise AssertionError(f"{argv} accepted")
-        err = capsys.readouterr().err
-        assert why in err and "Traceback" not in err
+        assert_main_refuses(capsys, argv + ["--out", ""], why)
     assert sc.routers({"default": {"router": "router2", "cong_mult": 1.3,
                                    "router2_settings": {"router2/histCongWeight": "2"}}}) == \
         ("`--router router2`, router2 setting `router2/currCongWeightMult` 1.3 (in the netlist, `--cong-mult`), "
