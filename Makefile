@@ -133,14 +133,15 @@ synth: setup
 	$(PY) scripts/synth.py --jobs $(JOBS)
 
 # The whole core (both configurations side by side, router2, each on the smallest ECP5 its counts
-# fit: default LFE5U-85F, compact LFE5U-45F; synth_ecp5 -nowidelut): counts of every engine,
-# post-route Fmax, cycles per tick -> the generated core section of docs/resources.md. The same
-# command as the recorded run there (tb/test_synth_core.py checks it). A routing still running
-# after ROUTE_MINUTES (the default core's does not converge) is stopped and reported with its last
-# router2 iteration; ROUTE_MINUTES= (empty) lets it run.
+# fit: default LFE5U-85F, compact LFE5U-45F; synth_ecp5 -nowidelut; router2's alternate weights,
+# without which the default core does not route): counts of every engine, post-route Fmax, cycles
+# per tick -> the generated core section of docs/resources.md. The same command as the recorded run
+# there (tb/test_synth_core.py checks it; 1 h 7 min on 2 cores, 2026-12-07). A routing still running
+# after ROUTE_MINUTES (the compact core's on LFE5U-45F does not converge at the current RTL) is
+# stopped and reported with its last router2 iteration; ROUTE_MINUTES= (empty) lets it run.
 ROUTE_MINUTES ?= 50
 synth-core: setup
-	$(PY) scripts/synth_core.py --no-widelut $(if $(ROUTE_MINUTES),--route-minutes $(ROUTE_MINUTES))
+	$(PY) scripts/synth_core.py --no-widelut --router2-alt-weights $(if $(ROUTE_MINUTES),--route-minutes $(ROUTE_MINUTES))
 
 # ---- register map (rtl/ts_servo_regs.rdl -> Verilog, C header, Python, docs) -------------------------
 regs: setup
